@@ -1,0 +1,6 @@
+//! The sEMG decoder: the causal filter bank, windowing and the 96 amplitude features
+//! (`dsp`), and the models that map features to per-finger force labels (`model`): ResDD and
+//! the paper's baselines, training, calibration sessions and evaluation.
+//!
+//! It knows nothing of sockets, threads or clocks, so the same code runs in the daemon, in
+//! offline evaluation, in replay and in the simulator, bit for bit.
