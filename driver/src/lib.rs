@@ -1,2 +1,11 @@
 //! The product: the `handd` daemon (the 50 ms control loop, its safety state machine and
 //! transports) and the technician CLI `handctl`.
+
+pub mod conditioner;
+pub mod config;
+pub mod safety;
+pub mod units;
+
+pub use conditioner::{FingerConditioner, FingerGains, Setpoint};
+pub use config::{Config, ConfigError};
+pub use safety::{DaemonState, Fault, FaultSet, Safety, SafetyTiming, Transition};

@@ -1,0 +1,493 @@
+//! The daemon's configuration: `/etc/handstack/handd.toml` by default.
+//!
+//! Every field is validated once at start (and on every `handctl tune`); an error names the
+//! field, the value and the allowed range, and the daemon refuses to start on it. Saving is
+//! atomic (temp file, fsync, rename, fsync of the directory), so a crash never leaves a broken
+//! file behind.
+
+use std::fmt;
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::conditioner::FingerGains;
+use crate::units::{FINGER_NAMES, N_FINGERS};
+
+/// The default location of the config file.
+pub const DEFAULT_CONFIG_PATH: &str = "/etc/handstack/handd.toml";
+
+/// Allowed ranges, inclusive. Force and velocity limits match the FINGER_SETPOINT signal
+/// ranges of hand.dbc, so a valid config can never ask for a value the bus cannot carry.
+pub mod limits {
+    /// kF, N per label unit.
+    pub const KF: (f64, f64) = (0.0, 40.0);
+    /// kα, rad/s² per label unit.
+    pub const KALPHA: (f64, f64) = (0.0, 50.0);
+    /// ω_max, rad/s.
+    pub const OMEGA_MAX: (f64, f64) = (0.01, 10.0);
+    /// Deadband, label units.
+    pub const DEADBAND: (f64, f64) = (0.0, 0.5);
+    /// Slew limit, label units per second.
+    pub const SLEW: (f64, f64) = (0.1, 100.0);
+    /// Velocity damping, 1/s.
+    pub const DAMPING: (f64, f64) = (0.0, 50.0);
+    /// Tick period, ms.
+    pub const TICK_MS: (u64, u64) = (10, 100);
+    /// EMG silence and finger silence timeouts, ms.
+    pub const SILENCE_MS: (u64, u64) = (20, 1000);
+    /// Recovery time of transient faults, ms.
+    pub const RECOVERY_MS: (u64, u64) = (100, 10_000);
+}
+
+/// A configuration error. Keeps the cause and names what to fix.
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    /// The file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The file is not valid TOML or has unknown or mistyped fields.
+    #[error("{path}: {message}")]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// The parser's message, with line and column.
+        message: String,
+    },
+    /// A field is out of its allowed range.
+    #[error("{field} = {value} is not allowed: {allowed}")]
+    Invalid {
+        /// The field, as `fingers.index.kf`.
+        field: String,
+        /// The value found.
+        value: String,
+        /// The allowed range or values.
+        allowed: String,
+    },
+}
+
+/// Per-finger settings as written in the file.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FingerConfig {
+    /// Force per label unit, N.
+    pub kf: f64,
+    /// Angular acceleration per label unit, rad/s².
+    pub kalpha: f64,
+    /// Largest commanded velocity, rad/s.
+    pub omega_max: f64,
+    /// Deadband on the label.
+    pub deadband: f64,
+    /// Slew limit on the label, per second.
+    pub slew: f64,
+    /// Velocity damping toward zero, 1/s (0 reproduces the paper).
+    pub damping: f64,
+}
+
+impl Default for FingerConfig {
+    fn default() -> Self {
+        let g = FingerGains::default();
+        Self {
+            kf: g.kf,
+            kalpha: g.kalpha,
+            omega_max: g.omega_max,
+            deadband: g.deadband,
+            slew: g.slew_per_s,
+            damping: g.damping_per_s,
+        }
+    }
+}
+
+impl FingerConfig {
+    /// The conditioner's view of these settings.
+    pub fn gains(&self) -> FingerGains {
+        FingerGains {
+            kf: self.kf,
+            kalpha: self.kalpha,
+            omega_max: self.omega_max,
+            deadband: self.deadband,
+            slew_per_s: self.slew,
+            damping_per_s: self.damping,
+        }
+    }
+}
+
+/// The five fingers' settings, by name.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct Fingers {
+    /// Finger 0.
+    pub thumb: FingerConfig,
+    /// Finger 1.
+    pub index: FingerConfig,
+    /// Finger 2.
+    pub middle: FingerConfig,
+    /// Finger 3.
+    pub ring: FingerConfig,
+    /// Finger 4.
+    pub pinky: FingerConfig,
+}
+
+impl Fingers {
+    /// Finger `f`'s settings (0 thumb .. 4 pinky).
+    pub fn get(&self, f: usize) -> &FingerConfig {
+        match f {
+            0 => &self.thumb,
+            1 => &self.index,
+            2 => &self.middle,
+            3 => &self.ring,
+            _ => &self.pinky,
+        }
+    }
+
+    /// Finger `f`'s settings, mutable.
+    pub fn get_mut(&mut self, f: usize) -> &mut FingerConfig {
+        match f {
+            0 => &mut self.thumb,
+            1 => &mut self.index,
+            2 => &mut self.middle,
+            3 => &mut self.ring,
+            _ => &mut self.pinky,
+        }
+    }
+}
+
+/// Timeouts, ms.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Timeouts {
+    /// No EMG frame for this long is a fault.
+    pub emg_silence_ms: u64,
+    /// A finger controller silent for this long is disabled.
+    pub finger_silence_ms: u64,
+    /// Transient faults clear after this long of good signal.
+    pub recovery_ms: u64,
+}
+
+impl Default for Timeouts {
+    fn default() -> Self {
+        Self {
+            emg_silence_ms: 100,
+            finger_silence_ms: 100,
+            recovery_ms: 500,
+        }
+    }
+}
+
+/// The technicians' control socket.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct ControlConfig {
+    /// Path of the Unix socket.
+    pub socket: PathBuf,
+    /// Group allowed to connect (besides root and the daemon's user); none = owner only.
+    pub group: Option<String>,
+    /// Audit log of every accepted change.
+    pub audit_log: PathBuf,
+}
+
+impl Default for ControlConfig {
+    fn default() -> Self {
+        Self {
+            socket: PathBuf::from("/run/handstack/handctl.sock"),
+            group: Some("handstack".into()),
+            audit_log: PathBuf::from("/var/lib/handstack/audit.log"),
+        }
+    }
+}
+
+/// The whole configuration.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Config {
+    /// SocketCAN interface name.
+    pub interface: String,
+    /// Path of the trained model file.
+    pub model: PathBuf,
+    /// Tick period, ms (50 in the paper).
+    pub tick_ms: u64,
+    /// Mains frequency for the notch, Hz: 50 or 60.
+    pub mains_hz: u32,
+    /// Timeouts.
+    pub timeouts: Timeouts,
+    /// Per-finger gains and limits.
+    pub fingers: Fingers,
+    /// The control socket.
+    pub control: ControlConfig,
+}
+
+impl Default for Config {
+    fn default() -> Self {
+        Self {
+            interface: "can0".into(),
+            model: PathBuf::from("/var/lib/handstack/model.json"),
+            tick_ms: 50,
+            mains_hz: 50,
+            timeouts: Timeouts::default(),
+            fingers: Fingers::default(),
+            control: ControlConfig::default(),
+        }
+    }
+}
+
+fn check_f64(field: String, v: f64, (lo, hi): (f64, f64)) -> Result<(), ConfigError> {
+    if v.is_finite() && v >= lo && v <= hi {
+        Ok(())
+    } else {
+        Err(ConfigError::Invalid {
+            field,
+            value: v.to_string(),
+            allowed: format!("{lo} to {hi}"),
+        })
+    }
+}
+
+fn check_u64(field: &str, v: u64, (lo, hi): (u64, u64)) -> Result<(), ConfigError> {
+    if (lo..=hi).contains(&v) {
+        Ok(())
+    } else {
+        Err(ConfigError::Invalid {
+            field: field.into(),
+            value: v.to_string(),
+            allowed: format!("{lo} to {hi}"),
+        })
+    }
+}
+
+impl FingerConfig {
+    /// Check every field; `name` prefixes the field in errors (`fingers.index`).
+    pub fn validate(&self, name: &str) -> Result<(), ConfigError> {
+        use limits::*;
+        check_f64(format!("{name}.kf"), self.kf, KF)?;
+        check_f64(format!("{name}.kalpha"), self.kalpha, KALPHA)?;
+        check_f64(format!("{name}.omega_max"), self.omega_max, OMEGA_MAX)?;
+        check_f64(format!("{name}.deadband"), self.deadband, DEADBAND)?;
+        check_f64(format!("{name}.slew"), self.slew, SLEW)?;
+        check_f64(format!("{name}.damping"), self.damping, DAMPING)
+    }
+}
+
+impl Config {
+    /// Check every field against its allowed range.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let name_ok = !self.interface.is_empty()
+            && self.interface.len() < 16
+            && self
+                .interface
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c));
+        if !name_ok {
+            return Err(ConfigError::Invalid {
+                field: "interface".into(),
+                value: format!("{:?}", self.interface),
+                allowed: "a network interface name of 1 to 15 characters [A-Za-z0-9._-]".into(),
+            });
+        }
+        if self.model.as_os_str().is_empty() {
+            return Err(ConfigError::Invalid {
+                field: "model".into(),
+                value: "\"\"".into(),
+                allowed: "the path of a model file made by `handctl train`".into(),
+            });
+        }
+        check_u64("tick_ms", self.tick_ms, limits::TICK_MS)?;
+        if self.mains_hz != 50 && self.mains_hz != 60 {
+            return Err(ConfigError::Invalid {
+                field: "mains_hz".into(),
+                value: self.mains_hz.to_string(),
+                allowed: "50 or 60".into(),
+            });
+        }
+        let t = &self.timeouts;
+        check_u64(
+            "timeouts.emg_silence_ms",
+            t.emg_silence_ms,
+            limits::SILENCE_MS,
+        )?;
+        check_u64(
+            "timeouts.finger_silence_ms",
+            t.finger_silence_ms,
+            limits::SILENCE_MS,
+        )?;
+        check_u64("timeouts.recovery_ms", t.recovery_ms, limits::RECOVERY_MS)?;
+        for (f, name) in FINGER_NAMES.iter().enumerate().take(N_FINGERS) {
+            self.fingers.get(f).validate(&format!("fingers.{name}"))?;
+        }
+        if self.control.socket.as_os_str().is_empty() {
+            return Err(ConfigError::Invalid {
+                field: "control.socket".into(),
+                value: "\"\"".into(),
+                allowed: "a filesystem path for the Unix socket".into(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Parse and validate TOML text; `path` only names the source in errors.
+    pub fn from_toml(text: &str, path: &Path) -> Result<Self, ConfigError> {
+        let cfg: Config = toml::from_str(text).map_err(|e| ConfigError::Parse {
+            path: path.to_owned(),
+            message: e.to_string().trim_end().to_owned(),
+        })?;
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
+    /// Read, parse and validate a config file.
+    pub fn load(path: &Path) -> Result<Self, ConfigError> {
+        let text = fs::read_to_string(path).map_err(|source| ConfigError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        Self::from_toml(&text, path)
+    }
+
+    /// The config as TOML text.
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).expect("a Config always serialises to TOML")
+    }
+
+    /// Validate, then save atomically: write a temp file beside the target, fsync it, rename it
+    /// over the target, fsync the directory. A crash at any point leaves either the old or the
+    /// new file, never a mix.
+    pub fn save_atomic(&self, path: &Path) -> Result<(), ConfigError> {
+        self.validate()?;
+        write_atomic(path, self.to_toml().as_bytes()).map_err(|source| ConfigError::Io {
+            path: path.to_owned(),
+            source,
+        })
+    }
+}
+
+/// Write `bytes` to `path` atomically (temp file in the same directory, fsync, rename, fsync of
+/// the directory).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
+        _ => PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "no file name"))?;
+    let tmp = dir.join(format!(
+        ".{}.tmp.{}",
+        name.to_string_lossy(),
+        std::process::id()
+    ));
+    let result = (|| {
+        let mut f = fs::File::create(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        drop(f);
+        fs::rename(&tmp, path)?;
+        fs::File::open(&dir)?.sync_all()
+    })();
+    if result.is_err() {
+        let _ = fs::remove_file(&tmp);
+    }
+    result
+}
+
+impl fmt::Display for FingerConfig {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "kf={} N kalpha={} rad/s² omega_max={} rad/s deadband={} slew={}/s damping={}/s",
+            self.kf, self.kalpha, self.omega_max, self.deadband, self.slew, self.damping
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_config_is_valid_and_round_trips() {
+        let c = Config::default();
+        c.validate().unwrap();
+        let back = Config::from_toml(&c.to_toml(), Path::new("x.toml")).unwrap();
+        assert_eq!(back, c);
+    }
+
+    #[test]
+    fn partial_file_takes_defaults() {
+        let c = Config::from_toml(
+            "interface = \"vcan0\"\n[fingers.index]\nkf = 0.8\nkalpha = 3\n",
+            Path::new("h.toml"),
+        )
+        .unwrap();
+        assert_eq!(c.interface, "vcan0");
+        assert_eq!(c.fingers.index.kf, 0.8);
+        assert_eq!(c.fingers.thumb, FingerConfig::default());
+    }
+
+    #[test]
+    fn out_of_range_names_field_value_and_range() {
+        let e = Config::from_toml("[fingers.ring]\nkf = 99.0\n", Path::new("h.toml")).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.contains("fingers.ring.kf") && msg.contains("99") && msg.contains("0 to 40"),
+            "{msg}"
+        );
+        let e = Config::from_toml("mains_hz = 55\n", Path::new("h.toml")).unwrap_err();
+        assert!(e.to_string().contains("mains_hz = 55"), "{e}");
+        let e =
+            Config::from_toml("[timeouts]\nrecovery_ms = 5\n", Path::new("h.toml")).unwrap_err();
+        assert!(e.to_string().contains("timeouts.recovery_ms"), "{e}");
+        let e = Config::from_toml("interface = \"a b\"\n", Path::new("h.toml")).unwrap_err();
+        assert!(e.to_string().contains("interface"), "{e}");
+    }
+
+    #[test]
+    fn unknown_field_and_bad_syntax_are_refused_with_location() {
+        let e = Config::from_toml("[fingers.index]\nkff = 1\n", Path::new("h.toml")).unwrap_err();
+        assert!(e.to_string().contains("kff"), "{e}");
+        let e = Config::from_toml("tick_ms = \n", Path::new("h.toml")).unwrap_err();
+        let msg = e.to_string();
+        assert!(msg.contains("h.toml") && msg.contains("line 1"), "{msg}");
+        let e = Config::from_toml("kf = nan\n", Path::new("h.toml")).unwrap_err();
+        assert!(matches!(e, ConfigError::Parse { .. }), "{e}");
+    }
+
+    #[test]
+    fn nan_gain_is_refused() {
+        let mut c = Config::default();
+        c.fingers.pinky.kalpha = f64::NAN;
+        let e = c.validate().unwrap_err();
+        assert!(e.to_string().contains("fingers.pinky.kalpha"), "{e}");
+    }
+
+    #[test]
+    fn atomic_save_replaces_the_file_and_refuses_invalid() {
+        let dir = std::env::temp_dir().join(format!("handd-cfg-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("handd.toml");
+        let mut c = Config::default();
+        c.save_atomic(&path).unwrap();
+        c.fingers.index.kf = 0.8;
+        c.save_atomic(&path).unwrap();
+        assert_eq!(Config::load(&path).unwrap().fingers.index.kf, 0.8);
+        c.fingers.index.kf = -1.0;
+        assert!(c.save_atomic(&path).is_err());
+        assert_eq!(
+            Config::load(&path).unwrap().fingers.index.kf,
+            0.8,
+            "unchanged on refusal"
+        );
+        let leftovers: Vec<_> = fs::read_dir(&dir)
+            .unwrap()
+            .filter_map(|e| e.ok())
+            .filter(|e| e.file_name().to_string_lossy().contains(".tmp."))
+            .collect();
+        assert!(leftovers.is_empty());
+        fs::remove_dir_all(&dir).unwrap();
+    }
+}
