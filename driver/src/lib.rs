@@ -3,7 +3,9 @@
 
 pub mod conditioner;
 pub mod config;
+pub mod protocol;
 pub mod safety;
+pub mod stats;
 pub mod units;
 
 pub use conditioner::{FingerConditioner, FingerGains, Setpoint};
