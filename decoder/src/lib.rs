@@ -4,3 +4,5 @@
 //!
 //! It knows nothing of sockets, threads or clocks, so the same code runs in the daemon, in
 //! offline evaluation, in replay and in the simulator, bit for bit.
+
+pub mod dsp;

@@ -1,0 +1,63 @@
+//! The causal sEMG signal chain: raw multi-channel samples in, the feature vector the model
+//! reads out.
+//!
+//! Per channel, every sample passes, in this order:
+//!
+//! 1. **DC removal**: a first-order Butterworth high-pass (bilinear, prewarped) at
+//!    [`ChainConfig::dc_cutoff_hz`] (default 1 Hz), i.e. `scipy.signal.butter(1, fc, 'highpass',
+//!    fs=fs, output='sos')`. It is the classic DC blocker `y = g (x[n] - x[n-1]) + R y[n-1]` with
+//!    `t = tan(pi fc / fs)`, `R = (1 - t) / (1 + t)`, `g = (1 + R) / 2`. The band-pass has zeros at
+//!    DC as well; removing a large electrode offset first keeps it out of the high-Q sections.
+//! 2. **Band-pass**: Butterworth of [`ChainConfig::bandpass_order`] between
+//!    [`ChainConfig::band_low_hz`] and [`ChainConfig::band_high_hz`], designed here in code as
+//!    second-order sections exactly as `scipy.signal.butter(order, [lo, hi], 'bandpass', fs=fs,
+//!    output='sos')` does (analog prototype, low-pass to band-pass, bilinear transform with
+//!    prewarping, `zpk2sos` with scipy's "nearest" pairing).
+//! 3. **Notch** at the mains frequency (and optionally its harmonics), each a biquad equal to
+//!    `scipy.signal.iirnotch(f, Q, fs)`.
+//! 4. **Full-wave rectification** `|y|` (switchable off with [`FeatureSignal::Filtered`]).
+//!
+//! Every section runs in transposed direct form II with the same operation order as scipy's
+//! `sosfilt`, so the filtered output equals `sosfilt` of the same sections to rounding.
+//!
+//! The last `window_len` processed values of each channel are kept in a ring buffer; every
+//! `step_len` samples (once the first window is full) the 8 features of the paper's Table 1 are
+//! computed per channel over the window `x[0..N]`, in the order of [`FEATURE_NAMES`]:
+//!
+//! | name  | formula |
+//! |-------|---------|
+//! | RMS   | `sqrt(sum x[i]^2 / N)` |
+//! | MAV   | `sum |x[i]| / N` |
+//! | VAR   | `sum (x[i] - mean)^2 / (N - 1)` |
+//! | SD    | `sqrt(VAR)` |
+//! | INT   | `sum |x[i]|` |
+//! | WL    | `sum_{i>=1} |x[i] - x[i-1]|` |
+//! | DASDV | `sqrt(sum_{i>=1} (x[i] - x[i-1])^2 / (N - 1))` |
+//! | DAMV  | `sum_{i>=1} |x[i] - x[i-1]| / (N - 1)` |
+//!
+//! The feature vector is channel-major: `[ch0 RMS, ch0 MAV, .., ch0 DAMV, ch1 RMS, ..]`, 8 values
+//! per channel (96 for 12 channels).
+//!
+//! Use: validate a [`ChainConfig`] once into [`ChainSettings`] (the only fallible step), build a
+//! [`Chain`] from it, then [`Chain::push`] one multi-channel sample at a time; nothing after
+//! validation allocates, returns a `Result` or panics on any input. Non-finite (or absurdly
+//! large) samples are counted per channel in [`Faults`], reset that channel's filter state and
+//! enter the filter as 0, so a channel recovers as soon as the bad samples leave the window.
+//! [`batch_features`] runs the very same streaming code over a whole recording.
+
+mod batch;
+mod chain;
+mod config;
+mod design;
+mod faults;
+mod features;
+pub mod npy;
+mod sos;
+
+pub use batch::{batch_features, batch_filtered, try_batch_features, BatchError, FeatureMatrix};
+pub use chain::Chain;
+pub use config::{ChainConfig, ChainSettings, ConfigError, FeatureSignal};
+pub use design::{butter_bandpass, dc_highpass, iirnotch};
+pub use faults::Faults;
+pub use features::{window_features, FEATURES_PER_CHANNEL, FEATURE_NAMES};
+pub use sos::Sos;
