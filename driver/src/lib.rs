@@ -3,6 +3,7 @@
 
 pub mod conditioner;
 pub mod config;
+pub mod control;
 pub mod protocol;
 pub mod safety;
 pub mod stats;
