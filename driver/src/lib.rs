@@ -7,6 +7,7 @@ pub mod control;
 pub mod protocol;
 pub mod safety;
 pub mod stats;
+pub mod tuning;
 pub mod units;
 
 pub use conditioner::{FingerConditioner, FingerGains, Setpoint};
