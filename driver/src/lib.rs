@@ -5,6 +5,7 @@ pub mod conditioner;
 pub mod config;
 pub mod control;
 pub mod protocol;
+pub mod rt;
 pub mod safety;
 pub mod stats;
 pub mod tuning;
