@@ -500,6 +500,10 @@ mod shipped {
     fn the_shipped_example_config_is_valid_and_holds_the_defaults() {
         let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/dist/handd.toml"));
         let c = Config::load(path).unwrap();
-        assert_eq!(c, Config::default(), "dist/handd.toml must document the defaults");
+        assert_eq!(
+            c,
+            Config::default(),
+            "dist/handd.toml must document the defaults"
+        );
     }
 }
