@@ -1,3 +1,15 @@
 //! The simulated world on the bus: an sEMG amplifier node, finger motor-controller nodes and a
 //! simulated patient, so that the daemon can be calibrated, run and broken without a person or
 //! a prosthesis.
+
+pub mod bus;
+pub mod clock;
+pub mod dbc;
+pub mod emg;
+pub mod error;
+pub mod finger;
+pub mod patient;
+
+pub use bus::{MemBus, MemBusError, MemEndpoint, Received};
+pub use clock::{Clock, SystemClock, VirtualClock};
+pub use error::SimError;

@@ -1,0 +1,222 @@
+//! The sEMG synthesiser: muscle activations in, one quantised 12-channel sample out.
+//!
+//! Per sample: each of the 10 sources draws white Gaussian noise, shapes it with a 2nd-order
+//! Butterworth high-pass and low-pass (defaults 30 and 150 Hz, giving a median frequency near
+//! 97 Hz, inside the 60..150 Hz of real forearm sEMG), scales it to unit RMS and then to
+//! `max_rms_uv · activation^curvature`. The cross-talk matrix mixes the sources into the 12
+//! channels; each channel then gets its mains residue, DC offset, slow drift and white noise
+//! floor, and the ADC rounds to the LSB and clips to the signed 12-bit range, reporting which
+//! channels clipped.
+
+use super::biquad::{Biquad, BiquadKind};
+use super::config::AmplifierConfig;
+use super::mixing::{crosstalk_matrix, N_CHANNELS, N_SOURCES};
+use super::noise::GaussianNoise;
+use crate::error::SimError;
+
+/// Smallest ADC count (signed 12-bit).
+pub const ADC_MIN: i16 = -2048;
+/// Largest ADC count (signed 12-bit).
+pub const ADC_MAX: i16 = 2047;
+
+/// Activation of the 10 muscle sources, each in 0..=1 (see [`super::mixing::flexor`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Activation(pub [f64; N_SOURCES]);
+
+/// One quantised sample of all channels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct EmgSample {
+    /// ADC counts per channel.
+    pub counts: [i16; N_CHANNELS],
+    /// Bit `c` set: channel `c` clipped at a rail in this sample.
+    pub saturated: u16,
+}
+
+#[derive(Debug, Clone)]
+struct MuscleSource {
+    hp: Biquad,
+    lp: Biquad,
+    /// Makes the shaped noise unit-RMS, so `max_rms_uv` means what it says.
+    norm: f64,
+    noise: GaussianNoise,
+}
+
+impl MuscleSource {
+    fn new(cfg: &AmplifierConfig, stream: u64) -> Self {
+        let hp = Biquad::butterworth(BiquadKind::HighPass, cfg.band_low_hz, cfg.sample_rate_hz);
+        let lp = Biquad::butterworth(BiquadKind::LowPass, cfg.band_high_hz, cfg.sample_rate_hz);
+        // Output variance for unit white input = energy of the impulse response; both poles
+        // are well inside the unit circle for validated cut-offs, so 2^15 taps converge.
+        let (mut h, mut l) = (hp, lp);
+        let mut energy = 0.0;
+        for i in 0..(1 << 15) {
+            let y = l.process(h.process(if i == 0 { 1.0 } else { 0.0 }));
+            energy += y * y;
+        }
+        Self {
+            hp,
+            lp,
+            norm: 1.0 / energy.sqrt(),
+            noise: GaussianNoise::new(cfg.seed, stream),
+        }
+    }
+
+    #[inline]
+    fn next(&mut self) -> f64 {
+        self.norm * self.lp.process(self.hp.process(self.noise.next_std()))
+    }
+}
+
+/// Per-channel faults the synthesiser applies after mixing (set by the amplifier node's
+/// fault plan).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ChannelFaults {
+    /// Bit `c`: electrode `c` has lost skin contact; the open input picks up mains at several
+    /// times full scale, so the channel shows a clipped 50/60 Hz square wave.
+    pub lead_off: u16,
+    /// Bit `c`: channel `c` is driven into the positive rail (e.g. a large motion artefact).
+    pub saturated: u16,
+}
+
+/// The 12-channel sEMG generator. Allocation-free per sample.
+#[derive(Debug, Clone)]
+pub struct EmgSynth {
+    cfg: AmplifierConfig,
+    sources: [MuscleSource; N_SOURCES],
+    mix: [[f64; N_SOURCES]; N_CHANNELS],
+    floor: [GaussianNoise; N_CHANNELS],
+    offset_uv: [f64; N_CHANNELS],
+    drift_w: [f64; N_CHANNELS],
+    drift_phase: [f64; N_CHANNELS],
+    mains_gain: [f64; N_CHANNELS],
+    mains_phase: [f64; N_CHANNELS],
+    n: u64,
+}
+
+impl EmgSynth {
+    /// Builds the generator from a config that passes [`AmplifierConfig::validate`].
+    pub fn try_new(cfg: AmplifierConfig) -> Result<Self, SimError> {
+        cfg.validate()?;
+        // Stream numbers: sources 0..10, channel floors 100..112, channel constants 200.
+        let sources = std::array::from_fn(|s| MuscleSource::new(&cfg, s as u64));
+        let floor = std::array::from_fn(|c| GaussianNoise::new(cfg.seed, 100 + c as u64));
+        let mut consts = GaussianNoise::new(cfg.seed, 200);
+        let mut offset_uv = [0.0; N_CHANNELS];
+        let mut drift_w = [0.0; N_CHANNELS];
+        let mut drift_phase = [0.0; N_CHANNELS];
+        let mut mains_gain = [0.0; N_CHANNELS];
+        let mut mains_phase = [0.0; N_CHANNELS];
+        let tau = std::f64::consts::TAU;
+        for c in 0..N_CHANNELS {
+            offset_uv[c] = consts.uniform(-cfg.dc_offset_uv, cfg.dc_offset_uv);
+            drift_w[c] = tau * cfg.drift_hz * consts.uniform(0.5, 1.5);
+            drift_phase[c] = consts.uniform(0.0, tau);
+            mains_gain[c] = consts.uniform(0.5, 1.0);
+            mains_phase[c] = consts.uniform(0.0, tau);
+        }
+        Ok(Self {
+            mix: crosstalk_matrix(cfg.crosstalk_width),
+            cfg,
+            sources,
+            floor,
+            offset_uv,
+            drift_w,
+            drift_phase,
+            mains_gain,
+            mains_phase,
+            n: 0,
+        })
+    }
+
+    /// The config this generator was built from.
+    pub fn config(&self) -> &AmplifierConfig {
+        &self.cfg
+    }
+
+    /// The cross-talk matrix in use (row = channel, column = source).
+    pub fn mixing(&self) -> &[[f64; N_SOURCES]; N_CHANNELS] {
+        &self.mix
+    }
+
+    /// Samples produced so far.
+    pub fn samples(&self) -> u64 {
+        self.n
+    }
+
+    /// The next sample, in µV before quantisation, written into `uv`.
+    pub fn next_uv(&mut self, act: &Activation, faults: ChannelFaults, uv: &mut [f64; N_CHANNELS]) {
+        let t = self.n as f64 / self.cfg.sample_rate_hz;
+        self.n += 1;
+        let mut src = [0.0; N_SOURCES];
+        for (s, (out, a)) in src.iter_mut().zip(act.0.iter()).enumerate() {
+            let amp = self.cfg.max_rms_uv * a.clamp(0.0, 1.0).powf(self.cfg.curvature);
+            // Every source draws its noise even at zero amplitude, so the random streams stay
+            // aligned whatever the intents: same seed, same noise, different scripts comparable.
+            *out = amp * self.sources[s].next();
+        }
+        let mains_w = std::f64::consts::TAU * self.cfg.mains.hz();
+        let full_scale = f64::from(ADC_MAX) * self.cfg.lsb_uv;
+        for (c, out) in uv.iter_mut().enumerate() {
+            let emg: f64 = self.mix[c].iter().zip(src.iter()).map(|(g, x)| g * x).sum();
+            let mains =
+                self.cfg.mains_uv * self.mains_gain[c] * (mains_w * t + self.mains_phase[c]).sin();
+            let drift = self.cfg.drift_uv * (self.drift_w[c] * t + self.drift_phase[c]).sin();
+            let noise = self.cfg.noise_floor_uv * self.floor[c].next_std();
+            let mut v = emg + mains + drift + noise + self.offset_uv[c];
+            let bit = 1u16 << c;
+            if faults.lead_off & bit != 0 {
+                v = 4.0 * full_scale * (mains_w * t + self.mains_phase[c]).sin();
+            }
+            if faults.saturated & bit != 0 {
+                v = 2.0 * full_scale;
+            }
+            *out = v;
+        }
+    }
+
+    /// The next sample, quantised to the ADC's LSB and clipped to its range.
+    pub fn next_sample(&mut self, act: &Activation, faults: ChannelFaults) -> EmgSample {
+        let mut uv = [0.0; N_CHANNELS];
+        self.next_uv(act, faults, &mut uv);
+        quantise(&uv, self.cfg.lsb_uv)
+    }
+}
+
+/// Rounds µV to ADC counts and clips to the signed 12-bit range, flagging clipped channels.
+pub fn quantise(uv: &[f64; N_CHANNELS], lsb_uv: f64) -> EmgSample {
+    let mut out = EmgSample::default();
+    for (c, (&v, q)) in uv.iter().zip(out.counts.iter_mut()).enumerate() {
+        let x = (v / lsb_uv).round();
+        if x >= f64::from(ADC_MAX) {
+            *q = ADC_MAX;
+            out.saturated |= u16::from(x > f64::from(ADC_MAX)) << c;
+        } else if x <= f64::from(ADC_MIN) {
+            *q = ADC_MIN;
+            out.saturated |= u16::from(x < f64::from(ADC_MIN)) << c;
+        } else {
+            *q = x as i16;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quantiser_rounds_and_reports_clipping() {
+        let mut uv = [0.0; N_CHANNELS];
+        uv[0] = 1.4;
+        uv[1] = -1.6;
+        uv[2] = 1e9;
+        uv[3] = -1e9;
+        uv[4] = 2047.0;
+        let s = quantise(&uv, 1.0);
+        assert_eq!(&s.counts[..5], &[1, -2, 2047, -2048, 2047]);
+        assert_eq!(
+            s.saturated, 0b1100,
+            "exactly-at-rail values are not clipping"
+        );
+    }
+}
