@@ -1,0 +1,242 @@
+//! Quality gates run before training: every trial must be usable, or the technician is told
+//! which trial to redo and why.
+//!
+//! * **Saturated channel**: more than `saturation_fraction` of a trial's raw samples on a channel
+//!   reach the front end's full scale (only when the session states its full scale).
+//! * **Flat channel** (lead-off, broken wire): the raw signal does not move at all, or its
+//!   windowed RMS is below `flat_ratio` times the median channel of the same trial.
+//! * **Too little contrast**: a flexion or extension trial's mean RMS (over channels and
+//!   windows) is below `min_contrast` times the mean of the rest trials.
+//! * **Weak repetition**: a trial's mean RMS is below `min_repeat_ratio` times the strongest
+//!   repetition of the same finger and kind.
+
+use super::error::SessionError;
+use super::trial::TrialKind;
+use super::windows::WindowOptions;
+use super::Session;
+use crate::eval::FEATURES_PER_CHANNEL;
+
+/// Thresholds of the gates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GateConfig {
+    /// Fraction of samples at full scale above which a channel counts as saturated.
+    pub saturation_fraction: f64,
+    /// A channel whose RMS is below this fraction of the trial's median channel is flat.
+    pub flat_ratio: f64,
+    /// Minimum ratio of a contraction's mean RMS to rest's.
+    pub min_contrast: f64,
+    /// Minimum ratio of a trial's mean RMS to its strongest repetition's.
+    pub min_repeat_ratio: f64,
+}
+
+impl Default for GateConfig {
+    fn default() -> Self {
+        Self {
+            saturation_fraction: 0.01,
+            flat_ratio: 0.02,
+            min_contrast: 1.5,
+            min_repeat_ratio: 0.5,
+        }
+    }
+}
+
+/// Which gate fired.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GateKind {
+    /// A channel sits at full scale.
+    Saturated {
+        /// Channel index.
+        channel: usize,
+    },
+    /// A channel does not move (lead-off).
+    Flat {
+        /// Channel index.
+        channel: usize,
+    },
+    /// The trial is hardly stronger than rest.
+    LowContrast,
+    /// The trial is much weaker than another repetition of it.
+    WeakRepetition,
+    /// The trial yields no window at all.
+    NoWindows,
+}
+
+/// One problem found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GateIssue {
+    /// The trial to redo.
+    pub trial_id: u32,
+    /// Which gate.
+    pub kind: GateKind,
+    /// What to tell the technician: the trial, the problem and what to do.
+    pub message: String,
+}
+
+/// The outcome of all gates.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct GateReport {
+    /// Problems, in trial order.
+    pub issues: Vec<GateIssue>,
+    /// Gates that could not run and why (e.g. no rest trial to compare against).
+    pub notes: Vec<String>,
+}
+
+impl GateReport {
+    /// True when no gate fired.
+    pub fn passed(&self) -> bool {
+        self.issues.is_empty()
+    }
+}
+
+impl std::fmt::Display for GateReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for i in &self.issues {
+            writeln!(f, "REDO {}", i.message)?;
+        }
+        for n in &self.notes {
+            writeln!(f, "note: {n}")?;
+        }
+        if self.passed() {
+            writeln!(f, "all quality gates passed")?;
+        }
+        Ok(())
+    }
+}
+
+/// Runs every gate over a session.
+pub fn check_gates(session: &Session, config: &GateConfig) -> Result<GateReport, SessionError> {
+    let windows = session.windows(&WindowOptions { two_point: false })?;
+    let ch = session.recording.channels;
+    let trials = &session.meta.trials;
+    let mut report = GateReport::default();
+
+    // Per trial, per channel: mean windowed RMS.
+    let mut rms = vec![vec![0.0; ch]; trials.len()];
+    let mut count = vec![0usize; trials.len()];
+    for (i, l) in windows.labels.iter().enumerate() {
+        let row = windows.row(i);
+        for (c, r) in rms[l.trial].iter_mut().enumerate() {
+            *r += row[c * FEATURES_PER_CHANNEL];
+        }
+        count[l.trial] += 1;
+    }
+    for (r, &n) in rms.iter_mut().zip(&count) {
+        if n > 0 {
+            r.iter_mut().for_each(|v| *v /= n as f64);
+        }
+    }
+    let strength: Vec<f64> = rms
+        .iter()
+        .map(|r| r.iter().sum::<f64>() / ch as f64)
+        .collect();
+
+    for (ti, t) in trials.iter().enumerate() {
+        if count[ti] == 0 {
+            report.issues.push(GateIssue {
+                trial_id: t.id,
+                kind: GateKind::NoWindows,
+                message: format!(
+                    "{t}: too short to give a single feature window; record it again, longer"
+                ),
+            });
+            continue;
+        }
+        let range = session.recording.range_of(t.start_us, t.end_us);
+        let raw = session.recording.slice(range.clone());
+        let n = range.len().max(1);
+        let mut median = rms[ti].clone();
+        median.sort_by(f64::total_cmp);
+        let median = median[ch / 2];
+        for (c, &chan_rms) in rms[ti].iter().enumerate() {
+            let column = raw.iter().skip(c).step_by(ch);
+            let (lo, hi) = column
+                .clone()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                    (lo.min(v), hi.max(v))
+                });
+            if let Some(fs) = session.meta.recording.full_scale {
+                let at_rail = column.filter(|v| v.abs() >= fs).count();
+                let frac = at_rail as f64 / n as f64;
+                if frac > config.saturation_fraction {
+                    report.issues.push(GateIssue {
+                        trial_id: t.id,
+                        kind: GateKind::Saturated { channel: c },
+                        message: format!(
+                            "{t}: channel {c} is saturated in {:.1}% of samples (full scale {fs}); \
+                             lower the gain or check the electrode, then record the trial again",
+                            100.0 * frac
+                        ),
+                    });
+                    continue;
+                }
+            }
+            if hi <= lo || chan_rms < config.flat_ratio * median {
+                report.issues.push(GateIssue {
+                    trial_id: t.id,
+                    kind: GateKind::Flat { channel: c },
+                    message: format!(
+                        "{t}: channel {c} is flat (RMS {:.3} against a median channel of {:.3}): \
+                         electrode off or lead broken; fix the electrode, then record the trial again",
+                        chan_rms, median
+                    ),
+                });
+            }
+        }
+    }
+
+    // Contrast against rest.
+    let rest: Vec<usize> = (0..trials.len())
+        .filter(|&i| trials[i].kind == TrialKind::Rest && count[i] > 0)
+        .collect();
+    if rest.is_empty() {
+        report
+            .notes
+            .push("no rest trial: the contrast gate did not run".into());
+    } else {
+        let rest_strength = rest.iter().map(|&i| strength[i]).sum::<f64>() / rest.len() as f64;
+        for (ti, t) in trials.iter().enumerate() {
+            if t.kind == TrialKind::Rest || count[ti] == 0 {
+                continue;
+            }
+            let ratio = strength[ti] / rest_strength;
+            if ratio.is_nan() || ratio < config.min_contrast {
+                report.issues.push(GateIssue {
+                    trial_id: t.id,
+                    kind: GateKind::LowContrast,
+                    message: format!(
+                        "{t}: only {ratio:.2}x the RMS of rest (needs {:.2}x): \
+                         record it again with a maximal contraction",
+                        config.min_contrast
+                    ),
+                });
+            }
+        }
+    }
+
+    // Repeatability within (finger, kind).
+    for (ti, t) in trials.iter().enumerate() {
+        if t.kind == TrialKind::Rest || count[ti] == 0 {
+            continue;
+        }
+        let best = (0..trials.len())
+            .filter(|&j| j != ti && count[j] > 0)
+            .filter(|&j| trials[j].kind == t.kind && trials[j].finger == t.finger)
+            .max_by(|&a, &b| strength[a].total_cmp(&strength[b]));
+        if let Some(j) = best {
+            let ratio = strength[ti] / strength[j];
+            if ratio < config.min_repeat_ratio {
+                report.issues.push(GateIssue {
+                    trial_id: t.id,
+                    kind: GateKind::WeakRepetition,
+                    message: format!(
+                        "{t}: only {ratio:.2}x the RMS of {} (needs {:.2}x): \
+                         record it again with the same maximal effort",
+                        trials[j], config.min_repeat_ratio
+                    ),
+                });
+            }
+        }
+    }
+    report.issues.sort_by_key(|i| i.trial_id);
+    Ok(report)
+}

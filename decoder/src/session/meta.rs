@@ -1,0 +1,342 @@
+//! `session.toml`: what a calibration session recorded and how to read it.
+//!
+//! ```toml
+//! format_version = 1
+//! onset_skip_ms = 0.0        # windows starting this soon after a trial's start are left out
+//!
+//! [chain]                    # decoder::dsp::ChainConfig; missing fields take the defaults
+//! channels = 12
+//! sample_rate_hz = 1000.0
+//!
+//! [recording]
+//! format = "candump"         # or "npy": samples n x channels, sample i at i * 1e6 / rate µs
+//! file = "frames.log"        # relative to the session directory, or absolute
+//! full_scale = 2047.0        # optional: |raw| at or beyond this is saturated
+//!
+//! [[segment]]                # optional: separate recordings, each filtered on its own
+//! start_us = 0
+//! end_us = 5000000
+//!
+//! [[trial]]
+//! id = 1
+//! finger = 1                 # 0 thumb .. 4 pinky, a finger name, or "all"
+//! kind = "flexion"           # flexion | extension | rest
+//! repetition = 1
+//! start_us = 1000000         # or start_sample / end_sample
+//! end_us = 4000000
+//! ```
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::error::SessionError;
+use super::trial::{Trial, TrialKind, FINGER_NAMES, N_FINGERS};
+use crate::dsp::ChainConfig;
+
+/// The `session.toml` format this code writes and reads.
+pub const FORMAT_VERSION: u32 = 1;
+/// Name of the metadata file in a session directory.
+pub const META_FILE: &str = "session.toml";
+
+/// How the raw signal is stored.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RecordingFormat {
+    /// A candump log of the bus (EMG_SAMPLES frames), as recorded on the device.
+    Candump,
+    /// A NumPy array `n_samples x channels` (int16, float32 or float64).
+    Npy,
+}
+
+/// Where the raw signal is.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RecordingSpec {
+    /// Storage format.
+    pub format: RecordingFormat,
+    /// File, relative to the session directory or absolute.
+    pub file: PathBuf,
+    /// Raw magnitude at which the front end saturates (same units as the samples); `None`:
+    /// unknown, saturation is then not checked.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub full_scale: Option<f64>,
+}
+
+/// A stretch of the recording filtered on its own (the filter state starts from reset).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Segment {
+    /// Start, µs, inclusive.
+    pub start_us: u64,
+    /// End, µs, exclusive.
+    pub end_us: u64,
+}
+
+/// The parsed and checked contents of `session.toml`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SessionMeta {
+    /// Chain configuration the session was recorded with (channel count, rate, filters).
+    pub chain: ChainConfig,
+    /// Windows that start less than this after a trial's start are not used (reaction time).
+    pub onset_skip_ms: f64,
+    /// The raw signal.
+    pub recording: RecordingSpec,
+    /// Separate recordings; empty = the whole recording is one.
+    pub segments: Vec<Segment>,
+    /// The trials, in file order.
+    pub trials: Vec<Trial>,
+}
+
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(untagged)]
+enum FingerField {
+    Index(i64),
+    Name(String),
+}
+
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TrialFile {
+    id: u32,
+    finger: FingerField,
+    kind: TrialKind,
+    repetition: u32,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    start_us: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    end_us: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    start_sample: Option<u64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    end_sample: Option<u64>,
+}
+
+#[derive(Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SessionFile {
+    format_version: u32,
+    #[serde(default)]
+    onset_skip_ms: f64,
+    chain: ChainConfig,
+    recording: RecordingSpec,
+    #[serde(default, rename = "segment", skip_serializing_if = "Vec::is_empty")]
+    segments: Vec<Segment>,
+    #[serde(default, rename = "trial")]
+    trials: Vec<TrialFile>,
+}
+
+fn parse_finger(f: &FingerField) -> Result<Option<usize>, String> {
+    match f {
+        FingerField::Index(i) if (0..N_FINGERS as i64).contains(i) => Ok(Some(*i as usize)),
+        FingerField::Index(i) => Err(format!(
+            "finger {i} is not 0..4 (0 thumb .. 4 pinky) or \"all\""
+        )),
+        FingerField::Name(s) => {
+            let s = s.trim().to_ascii_lowercase();
+            if s == "all" {
+                return Ok(None);
+            }
+            FINGER_NAMES
+                .iter()
+                .position(|n| *n == s)
+                .map(Some)
+                .ok_or_else(|| format!("finger \"{s}\" is not 0..4, a finger name or \"all\""))
+        }
+    }
+}
+
+fn us_of_sample(sample: u64, rate_hz: f64) -> u64 {
+    (sample as f64 * 1e6 / rate_hz).round() as u64
+}
+
+impl SessionMeta {
+    /// Parses and checks the text of a `session.toml`; `path` is only used in messages.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, SessionError> {
+        let file: SessionFile = toml::from_str(text).map_err(|e| SessionError::Toml {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        if file.format_version != FORMAT_VERSION {
+            return Err(SessionError::invalid(
+                path,
+                format!(
+                    "format_version {} is not supported (this build reads {FORMAT_VERSION})",
+                    file.format_version
+                ),
+            ));
+        }
+        let settings = file.chain.validate()?;
+        let rate = settings.sample_rate_hz();
+        let mut trials = Vec::with_capacity(file.trials.len());
+        for t in &file.trials {
+            let bad = |m: String| SessionError::invalid(path, format!("trial {}: {m}", t.id));
+            let finger = parse_finger(&t.finger).map_err(bad)?;
+            let (start_us, end_us) = match (t.start_us, t.end_us, t.start_sample, t.end_sample) {
+                (Some(s), Some(e), None, None) => (s, e),
+                (None, None, Some(s), Some(e)) => (us_of_sample(s, rate), us_of_sample(e, rate)),
+                _ => {
+                    return Err(bad(
+                        "give either start_us and end_us, or start_sample and end_sample".into(),
+                    ))
+                }
+            };
+            let trial = Trial {
+                id: t.id,
+                finger,
+                kind: t.kind,
+                repetition: t.repetition,
+                start_us,
+                end_us,
+            };
+            trials.push(trial);
+        }
+        let meta = SessionMeta {
+            chain: file.chain,
+            onset_skip_ms: file.onset_skip_ms,
+            recording: file.recording,
+            segments: file.segments,
+            trials,
+        };
+        meta.check(path)?;
+        Ok(meta)
+    }
+
+    /// Checks what parsing cannot: ids unique, times ordered, trials inside one segment.
+    pub fn check(&self, path: &Path) -> Result<(), SessionError> {
+        self.chain.validate()?;
+        if !(self.onset_skip_ms >= 0.0 && self.onset_skip_ms.is_finite()) {
+            return Err(SessionError::invalid(
+                path,
+                format!(
+                    "onset_skip_ms {} must be finite and >= 0",
+                    self.onset_skip_ms
+                ),
+            ));
+        }
+        if self.trials.is_empty() {
+            return Err(SessionError::invalid(path, "the session has no [[trial]]"));
+        }
+        for (i, s) in self.segments.iter().enumerate() {
+            if s.end_us <= s.start_us {
+                return Err(SessionError::invalid(
+                    path,
+                    format!(
+                        "segment {i}: end_us {} is not after start_us {}",
+                        s.end_us, s.start_us
+                    ),
+                ));
+            }
+        }
+        let mut ids = HashSet::new();
+        for t in &self.trials {
+            if !ids.insert(t.id) {
+                return Err(SessionError::invalid(
+                    path,
+                    format!("trial id {} appears twice", t.id),
+                ));
+            }
+            if t.end_us <= t.start_us {
+                return Err(SessionError::invalid(
+                    path,
+                    format!(
+                        "{t}: end {} µs is not after start {} µs",
+                        t.end_us, t.start_us
+                    ),
+                ));
+            }
+            if let Some(f) = t.finger {
+                if f >= N_FINGERS {
+                    return Err(SessionError::invalid(
+                        path,
+                        format!("{t}: finger {f} is not 0..4"),
+                    ));
+                }
+            }
+            if !self.segments.is_empty() && self.segment_of(t).is_none() {
+                return Err(SessionError::invalid(
+                    path,
+                    format!(
+                        "{t} ({}..{} µs) does not lie inside one [[segment]]",
+                        t.start_us, t.end_us
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// Index of the segment holding the whole trial (0 when there are no segments).
+    pub fn segment_of(&self, trial: &Trial) -> Option<usize> {
+        if self.segments.is_empty() {
+            return Some(0);
+        }
+        self.segments
+            .iter()
+            .position(|s| s.start_us <= trial.start_us && trial.end_us <= s.end_us)
+    }
+
+    /// The TOML text of this metadata (trial times in µs).
+    pub fn to_toml(&self) -> String {
+        let file = SessionFile {
+            format_version: FORMAT_VERSION,
+            onset_skip_ms: self.onset_skip_ms,
+            chain: self.chain.clone(),
+            recording: self.recording.clone(),
+            segments: self.segments.clone(),
+            trials: self
+                .trials
+                .iter()
+                .map(|t| TrialFile {
+                    id: t.id,
+                    finger: match t.finger {
+                        Some(f) => FingerField::Index(f as i64),
+                        None => FingerField::Name("all".into()),
+                    },
+                    kind: t.kind,
+                    repetition: t.repetition,
+                    start_us: Some(t.start_us),
+                    end_us: Some(t.end_us),
+                    start_sample: None,
+                    end_sample: None,
+                })
+                .collect(),
+        };
+        // Serialising plain data with finite numbers cannot fail.
+        toml::to_string(&file).unwrap_or_else(|e| panic!("session.toml serialisation: {e}"))
+    }
+
+    /// Reads `dir/session.toml`.
+    pub fn read(dir: &Path) -> Result<Self, SessionError> {
+        let path = dir.join(META_FILE);
+        let text = std::fs::read_to_string(&path).map_err(|e| SessionError::io(&path, e))?;
+        Self::parse(&text, &path)
+    }
+
+    /// Writes `dir/session.toml` atomically (temporary file, fsync, rename).
+    pub fn write(&self, dir: &Path) -> Result<(), SessionError> {
+        std::fs::create_dir_all(dir).map_err(|e| SessionError::io(dir, e))?;
+        write_atomic(&dir.join(META_FILE), self.to_toml().as_bytes())
+    }
+
+    /// The recording's file, resolved against the session directory.
+    pub fn recording_path(&self, dir: &Path) -> PathBuf {
+        if self.recording.file.is_absolute() {
+            self.recording.file.clone()
+        } else {
+            dir.join(&self.recording.file)
+        }
+    }
+}
+
+/// Writes a file so that a crash leaves either the old or the new contents, never a torn file.
+pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SessionError> {
+    use std::io::Write;
+    let tmp = path.with_extension("tmp");
+    let mut f = std::fs::File::create(&tmp).map_err(|e| SessionError::io(&tmp, e))?;
+    f.write_all(bytes).map_err(|e| SessionError::io(&tmp, e))?;
+    f.sync_all().map_err(|e| SessionError::io(&tmp, e))?;
+    drop(f);
+    std::fs::rename(&tmp, path).map_err(|e| SessionError::io(path, e))
+}

@@ -1,0 +1,102 @@
+//! The raw multi-channel signal of a session, from a candump log or a sample file.
+
+use std::path::Path;
+
+use super::error::SessionError;
+use super::meta::{RecordingFormat, SessionMeta};
+
+/// Raw samples with their times.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recording {
+    /// Channels per sample.
+    pub channels: usize,
+    /// Row-major `n x channels` raw values (µV for candump logs, file units for sample files).
+    pub samples: Vec<f64>,
+    /// Time of each sample, µs, non-decreasing.
+    pub time_us: Vec<u64>,
+    /// Samples the bus lost and the assembler bridged (0 for sample files).
+    pub lost_samples: u64,
+}
+
+impl Recording {
+    /// Builds a recording from evenly spaced samples (sample `i` at `i * 1e6 / rate` µs).
+    pub fn from_samples(
+        channels: usize,
+        samples: Vec<f64>,
+        sample_rate_hz: f64,
+    ) -> Result<Self, String> {
+        if channels == 0 || !samples.len().is_multiple_of(channels) {
+            return Err(format!(
+                "{} values is not a whole number of samples of {channels} channels",
+                samples.len()
+            ));
+        }
+        if let Some(i) = samples.iter().position(|v| !v.is_finite()) {
+            return Err(format!(
+                "sample {} channel {} is not finite",
+                i / channels,
+                i % channels
+            ));
+        }
+        let n = samples.len() / channels;
+        let time_us = (0..n)
+            .map(|i| (i as f64 * 1e6 / sample_rate_hz).round() as u64)
+            .collect();
+        Ok(Recording {
+            channels,
+            samples,
+            time_us,
+            lost_samples: 0,
+        })
+    }
+
+    /// Number of multi-channel samples.
+    pub fn len(&self) -> usize {
+        self.time_us.len()
+    }
+
+    /// True when there is no sample.
+    pub fn is_empty(&self) -> bool {
+        self.time_us.is_empty()
+    }
+
+    /// Sample index range `[start, end)` of the samples timed in `[start_us, end_us)`.
+    pub fn range_of(&self, start_us: u64, end_us: u64) -> std::ops::Range<usize> {
+        let a = self.time_us.partition_point(|&t| t < start_us);
+        let b = self.time_us.partition_point(|&t| t < end_us);
+        a..b.max(a)
+    }
+
+    /// Samples `range` as a row-major slice.
+    pub fn slice(&self, range: std::ops::Range<usize>) -> &[f64] {
+        &self.samples[range.start * self.channels..range.end * self.channels]
+    }
+
+    /// Reads the recording a session's metadata points to.
+    pub fn load(meta: &SessionMeta, dir: &Path) -> Result<Self, SessionError> {
+        let path = meta.recording_path(dir);
+        match meta.recording.format {
+            RecordingFormat::Npy => load_npy(meta, &path),
+            RecordingFormat::Candump => super::candump::load_candump(meta, &path),
+        }
+    }
+}
+
+fn load_npy(meta: &SessionMeta, path: &Path) -> Result<Recording, SessionError> {
+    let arr = crate::dsp::npy::read_npy(path).map_err(|e| match e {
+        crate::dsp::npy::NpyError::Io { source, .. } => SessionError::io(path, source),
+        other => SessionError::recording(path, other.to_string()),
+    })?;
+    let channels = meta.chain.channels;
+    if arr.shape.len() != 2 || arr.shape[1] != channels {
+        return Err(SessionError::recording(
+            path,
+            format!(
+                "shape {:?} is not (n_samples, {channels}) as [chain] channels says",
+                arr.shape
+            ),
+        ));
+    }
+    Recording::from_samples(channels, arr.data, meta.chain.sample_rate_hz)
+        .map_err(|m| SessionError::recording(path, m))
+}

@@ -1,0 +1,74 @@
+//! The 3DC armband recordings as a proxy calibration session.
+
+use std::path::{Path, PathBuf};
+
+use decoder::session::{
+    check_gates, import_3dc, load_3dc, GateConfig, Session, Split, TrialKind, WindowOptions,
+};
+
+fn data_dir() -> PathBuf {
+    let d = PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../shared/data/3dc-armband-p4"
+    ));
+    assert!(
+        d.join("P4_train_emg.npy").exists(),
+        "{} is missing: the tests read the real recordings from ../shared/data",
+        d.display()
+    );
+    d
+}
+
+#[test]
+fn both_splits_load_as_sessions() {
+    for split in [Split::Train, Split::Test] {
+        let s = load_3dc(&data_dir(), split).unwrap();
+        assert_eq!(s.recording.channels, 10);
+        assert_eq!(
+            s.meta.trials.len(),
+            12,
+            "4 repetitions of rest, power grip, open hand"
+        );
+        for kind in [TrialKind::Rest, TrialKind::Flexion, TrialKind::Extension] {
+            assert_eq!(s.meta.trials.iter().filter(|t| t.kind == kind).count(), 4);
+        }
+        assert!(s.meta.trials.iter().all(|t| t.finger.is_none()));
+        let w = s.windows(&WindowOptions::default()).unwrap();
+        // About 5 s per recording, less the 0.5 s onset skip and one window: ~85 windows each.
+        assert!(
+            w.len() > 12 * 60 && w.len() < 12 * 100,
+            "{} windows",
+            w.len()
+        );
+        let flex = w
+            .labels
+            .iter()
+            .find(|l| s.meta.trials[l.trial].kind == TrialKind::Flexion)
+            .unwrap();
+        assert_eq!(flex.targets, [1.0; 5]);
+        assert_eq!(flex.mask, [true; 5]);
+        let r = check_gates(&s, &GateConfig::default()).unwrap();
+        println!("3dc {}: {} windows; gates:\n{r}", split.name(), w.len());
+    }
+}
+
+#[test]
+fn import_writes_a_session_that_opens_the_same() {
+    let out = std::env::temp_dir().join(format!("handstack-3dc-import-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&out);
+    let meta = import_3dc(&data_dir(), Split::Test, &out).unwrap();
+    let opened = Session::open(&out).unwrap();
+    assert_eq!(opened.meta, meta);
+    let direct = Session::open_spec(&format!("3dc:{}:test", data_dir().display())).unwrap();
+    assert_eq!(direct.recording, opened.recording);
+    assert!(Path::new(&opened.meta.recording.file).is_absolute());
+    let e = Session::open_spec("3dc:/nonexistent:test")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("/nonexistent"), "{e}");
+    let e = Session::open_spec("3dc:/x:validation")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("validation"), "{e}");
+    std::fs::remove_dir_all(&out).unwrap();
+}
