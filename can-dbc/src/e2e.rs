@@ -1,0 +1,353 @@
+//! End-to-end (E2E) protection of safety-relevant frames: an alive counter and a CRC-8.
+//!
+//! Layout (fixed for every protected message of hand.dbc, checked by the code generator):
+//! byte 0 is the CRC, the low 4 or 8 bits of byte 1 are the alive counter. The CRC is CRC-8
+//! SAE J1850 (poly 0x1D, init 0xFF, xorout 0xFF, not reflected) over the message's 16-bit data
+//! id (low byte first) followed by payload bytes 1..DLC. Because the data id enters the CRC but
+//! is never sent, a frame that is correct for one message is rejected when it arrives under
+//! another id (a corrupted id, or a sender mixing up buffers).
+//!
+//! The receiver side follows AUTOSAR E2E Profile 1: [`E2eChecker::check`] classifies each
+//! reception as [`E2eStatus::Ok`], [`E2eStatus::Repeated`], [`E2eStatus::WrongSequence`],
+//! [`E2eStatus::Error`] or [`E2eStatus::NoNewData`].
+
+use crate::frame::CanFrame;
+
+/// CRC-8 SAE J1850 lookup table (poly 0x1D), built at compile time.
+const CRC8_TABLE: [u8; 256] = {
+    let mut table = [0u8; 256];
+    let mut i = 0;
+    while i < 256 {
+        let mut crc = i as u8;
+        let mut bit = 0;
+        while bit < 8 {
+            crc = if crc & 0x80 != 0 {
+                (crc << 1) ^ 0x1D
+            } else {
+                crc << 1
+            };
+            bit += 1;
+        }
+        table[i] = crc;
+        i += 1;
+    }
+    table
+};
+
+/// Feeds `data` into a running (not yet finalised) J1850 CRC register.
+fn crc8_update(mut crc: u8, data: &[u8]) -> u8 {
+    for &byte in data {
+        crc = CRC8_TABLE[usize::from(crc ^ byte)];
+    }
+    crc
+}
+
+/// CRC-8 SAE J1850 of `data`: poly 0x1D, init 0xFF, xorout 0xFF (check value of "123456789"
+/// is 0x4B).
+pub fn crc8_j1850(data: &[u8]) -> u8 {
+    crc8_update(0xFF, data) ^ 0xFF
+}
+
+/// What went wrong configuring or applying E2E protection.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum E2eError {
+    /// Counter width other than 4 or 8 bits.
+    #[error("E2E counter must be 4 or 8 bits wide, got {bits}")]
+    CounterBits {
+        /// The refused width.
+        bits: u8,
+    },
+    /// A protected message needs at least the CRC byte and the counter byte.
+    #[error("E2E-protected payload must be 2..=8 bytes, got {dlc}")]
+    Dlc {
+        /// The refused length.
+        dlc: usize,
+    },
+    /// Max delta counter must be at least 1 and below the counter's modulus.
+    #[error("max delta counter must be in 1..={max}, got {value}")]
+    MaxDelta {
+        /// The refused value.
+        value: u16,
+        /// Largest allowed value.
+        max: u16,
+    },
+    /// A frame whose payload length differs from the profile's.
+    #[error(
+        "payload has {got} bytes, the E2E profile (data id {data_id:#06x}) expects {expected}"
+    )]
+    Length {
+        /// Data id of the profile.
+        data_id: u16,
+        /// Length of the profile.
+        expected: usize,
+        /// Length given.
+        got: usize,
+    },
+    /// A frame of another message handed to a protector.
+    #[error("message with data id {got:#06x} handed to the protector of data id {expected:#06x}")]
+    WrongMessage {
+        /// The protector's data id.
+        expected: u16,
+        /// The message's data id.
+        got: u16,
+    },
+}
+
+/// The E2E parameters of one message (or one instance of a per-finger message).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct E2eProfile {
+    data_id: u16,
+    counter_bits: u8,
+    dlc: u8,
+}
+
+impl E2eProfile {
+    /// Builds a profile: `counter_bits` 4 or 8, `dlc` 2..=8.
+    pub fn try_new(data_id: u16, counter_bits: u8, dlc: usize) -> Result<Self, E2eError> {
+        if counter_bits != 4 && counter_bits != 8 {
+            return Err(E2eError::CounterBits { bits: counter_bits });
+        }
+        if !(2..=8).contains(&dlc) {
+            return Err(E2eError::Dlc { dlc });
+        }
+        Ok(Self {
+            data_id,
+            counter_bits,
+            dlc: dlc as u8,
+        })
+    }
+
+    /// Profile from hand.dbc; the code generator has validated the arguments.
+    pub(crate) const fn from_dbc(data_id: u16, counter_bits: u8, dlc: u8) -> Self {
+        Self {
+            data_id,
+            counter_bits,
+            dlc,
+        }
+    }
+
+    /// The data id that enters the CRC.
+    pub fn data_id(&self) -> u16 {
+        self.data_id
+    }
+
+    /// Width of the alive counter in bits (4 or 8).
+    pub fn counter_bits(&self) -> u8 {
+        self.counter_bits
+    }
+
+    /// Payload length of the protected message.
+    pub fn dlc(&self) -> usize {
+        usize::from(self.dlc)
+    }
+
+    /// Number of distinct counter values (16 or 256).
+    pub fn counter_modulus(&self) -> u16 {
+        1 << self.counter_bits
+    }
+
+    fn counter_mask(&self) -> u8 {
+        if self.counter_bits == 8 {
+            0xFF
+        } else {
+            0x0F
+        }
+    }
+
+    /// The CRC that `data` (a whole payload, byte 0 included but ignored) should carry.
+    /// `data` must hold at least 1 byte; bytes past the first are covered.
+    pub fn crc(&self, data: &[u8]) -> u8 {
+        let id = self.data_id.to_le_bytes();
+        let crc = crc8_update(0xFF, &id);
+        let rest = data.get(1..).unwrap_or(&[]);
+        crc8_update(crc, rest) ^ 0xFF
+    }
+
+    /// The alive counter carried by `data` (0 if `data` has no counter byte).
+    pub fn counter(&self, data: &[u8]) -> u8 {
+        data.get(1).map_or(0, |b| b & self.counter_mask())
+    }
+}
+
+/// Sender side: stamps consecutive alive counters and the CRC into outgoing frames.
+#[derive(Debug, Clone)]
+pub struct E2eProtector {
+    profile: E2eProfile,
+    next_counter: u8,
+}
+
+impl E2eProtector {
+    /// A protector whose first frame carries counter 0.
+    pub fn new(profile: E2eProfile) -> Self {
+        Self {
+            profile,
+            next_counter: 0,
+        }
+    }
+
+    /// The profile in use.
+    pub fn profile(&self) -> E2eProfile {
+        self.profile
+    }
+
+    /// The counter the next protected frame will carry.
+    pub fn next_counter(&self) -> u8 {
+        self.next_counter
+    }
+
+    /// Writes the next counter into byte 1 (other bits of byte 1 kept) and the CRC into byte 0,
+    /// then advances the counter (wrapping at 16 or 256, as AUTOSAR counters do). Returns the
+    /// counter written.
+    pub fn protect_bytes(&mut self, data: &mut [u8]) -> Result<u8, E2eError> {
+        if data.len() != self.profile.dlc() {
+            return Err(E2eError::Length {
+                data_id: self.profile.data_id,
+                expected: self.profile.dlc(),
+                got: data.len(),
+            });
+        }
+        let counter = self.next_counter;
+        let mask = self.profile.counter_mask();
+        data[1] = (data[1] & !mask) | counter;
+        data[0] = self.profile.crc(data);
+        self.next_counter = counter.wrapping_add(1) & mask;
+        Ok(counter)
+    }
+
+    /// [`Self::protect_bytes`] on a frame's payload.
+    pub fn protect(&mut self, frame: &mut CanFrame) -> Result<u8, E2eError> {
+        self.protect_bytes(frame.data_mut())
+    }
+
+    /// Encodes a generated message, protects it and returns the frame to send.
+    pub fn protect_message<M: Protected>(&mut self, message: &M) -> Result<CanFrame, E2eError> {
+        let profile = message.e2e_profile();
+        if profile != self.profile {
+            return Err(E2eError::WrongMessage {
+                expected: self.profile.data_id,
+                got: profile.data_id,
+            });
+        }
+        let mut frame = message.to_frame();
+        self.protect(&mut frame)?;
+        Ok(frame)
+    }
+}
+
+/// A generated message type that carries E2E protection.
+pub trait Protected {
+    /// The message's (or this instance's) E2E profile from hand.dbc.
+    fn e2e_profile(&self) -> E2eProfile;
+    /// The message encoded into a frame, counter and CRC as currently set.
+    fn to_frame(&self) -> CanFrame;
+}
+
+/// Receiver-side classification of one reception (AUTOSAR E2E Profile 1 semantics).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum E2eStatus {
+    /// CRC correct and the counter advanced by 1..=allowed delta (lost frames in between are
+    /// counted, see [`E2eChecker::lost_frames`]); also the first correct frame after start.
+    Ok,
+    /// CRC correct but the counter did not change: the same frame again.
+    Repeated,
+    /// CRC correct but the counter jumped further than allowed (too many frames lost, or a
+    /// stale sender). The counter becomes the new reference, so the stream resynchronises.
+    WrongSequence,
+    /// Wrong CRC (corruption, or a frame of another message) or wrong length.
+    Error,
+    /// Nothing was received for this check.
+    NoNewData,
+}
+
+/// Receiver side: classifies each reception of one message stream.
+#[derive(Debug, Clone)]
+pub struct E2eChecker {
+    profile: E2eProfile,
+    max_delta: u16,
+    last_counter: Option<u8>,
+    no_new_data: u16,
+    lost_frames: u64,
+}
+
+impl E2eChecker {
+    /// A checker that accepts counter steps of up to `max_delta_counter` (1 = no loss
+    /// tolerated; at most modulus - 1).
+    pub fn try_new(profile: E2eProfile, max_delta_counter: u16) -> Result<Self, E2eError> {
+        let max = profile.counter_modulus() - 1;
+        if max_delta_counter == 0 || max_delta_counter > max {
+            return Err(E2eError::MaxDelta {
+                value: max_delta_counter,
+                max,
+            });
+        }
+        Ok(Self {
+            profile,
+            max_delta: max_delta_counter,
+            last_counter: None,
+            no_new_data: 0,
+            lost_frames: 0,
+        })
+    }
+
+    /// The profile in use.
+    pub fn profile(&self) -> E2eProfile {
+        self.profile
+    }
+
+    /// Frames skipped inside accepted counter steps since start.
+    pub fn lost_frames(&self) -> u64 {
+        self.lost_frames
+    }
+
+    /// Forgets the reference counter: the next correct frame is accepted as the first.
+    pub fn reset(&mut self) {
+        self.last_counter = None;
+        self.no_new_data = 0;
+    }
+
+    /// Classifies one reception: `Some(payload)` for a received frame, `None` when the
+    /// receiver's cycle found nothing new. As in AUTOSAR Profile 1, every `None` widens the
+    /// allowed counter step of the next frame by one (up to modulus - 1), since the sender
+    /// kept counting while nothing arrived.
+    pub fn check(&mut self, data: Option<&[u8]>) -> E2eStatus {
+        let Some(data) = data else {
+            self.no_new_data = self.no_new_data.saturating_add(1);
+            return E2eStatus::NoNewData;
+        };
+        if data.len() != self.profile.dlc() || data[0] != self.profile.crc(data) {
+            return E2eStatus::Error;
+        }
+        let counter = self.profile.counter(data);
+        let modulus = self.profile.counter_modulus();
+        let Some(last) = self.last_counter else {
+            self.last_counter = Some(counter);
+            self.no_new_data = 0;
+            return E2eStatus::Ok;
+        };
+        let delta = (u16::from(counter) + modulus - u16::from(last)) % modulus;
+        let allowed = self
+            .max_delta
+            .saturating_add(self.no_new_data)
+            .min(modulus - 1);
+        if delta == 0 {
+            return E2eStatus::Repeated;
+        }
+        self.last_counter = Some(counter);
+        self.no_new_data = 0;
+        if delta <= allowed {
+            self.lost_frames += u64::from(delta - 1);
+            E2eStatus::Ok
+        } else {
+            E2eStatus::WrongSequence
+        }
+    }
+
+    /// [`Self::check`] on a frame (a remote frame counts as an error).
+    pub fn check_frame(&mut self, frame: Option<&CanFrame>) -> E2eStatus {
+        match frame {
+            Some(f) if f.is_remote() => E2eStatus::Error,
+            Some(f) => self.check(Some(f.data())),
+            None => self.check(None),
+        }
+    }
+}
