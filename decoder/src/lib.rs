@@ -6,3 +6,4 @@
 //! offline evaluation, in replay and in the simulator, bit for bit.
 
 pub mod dsp;
+pub mod model;

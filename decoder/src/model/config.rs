@@ -1,0 +1,189 @@
+//! Training settings: optimizer, batching, early stopping, validation split, seed.
+
+use serde::{Deserialize, Serialize};
+
+use super::error::TrainError;
+
+/// Gradient step rule.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "name", rename_all = "snake_case")]
+pub enum Optimizer {
+    /// Adam (Kingma & Ba) with bias correction.
+    Adam {
+        /// Learning rate (default 1e-3).
+        lr: f64,
+        /// First-moment decay (default 0.9).
+        beta1: f64,
+        /// Second-moment decay (default 0.999).
+        beta2: f64,
+        /// Denominator guard (default 1e-8).
+        eps: f64,
+    },
+    /// SGD with (heavy-ball) momentum: `v = μ·v + g`, `θ -= lr·v`.
+    Sgd {
+        /// Learning rate (default 0.01).
+        lr: f64,
+        /// Momentum μ (default 0.9).
+        momentum: f64,
+    },
+}
+
+impl Optimizer {
+    /// Adam with the usual defaults.
+    pub fn adam() -> Self {
+        Optimizer::Adam {
+            lr: 1e-3,
+            beta1: 0.9,
+            beta2: 0.999,
+            eps: 1e-8,
+        }
+    }
+
+    /// SGD with momentum 0.9, learning rate 0.01.
+    pub fn sgd() -> Self {
+        Optimizer::Sgd {
+            lr: 0.01,
+            momentum: 0.9,
+        }
+    }
+
+    fn validate(&self) -> Result<(), TrainError> {
+        let bad = |m: String| Err(TrainError::Config(m));
+        match *self {
+            Optimizer::Adam {
+                lr,
+                beta1,
+                beta2,
+                eps,
+            } => {
+                if !(lr > 0.0 && lr.is_finite()) {
+                    return bad(format!(
+                        "Adam learning rate must be > 0 and finite, got {lr}"
+                    ));
+                }
+                if !(0.0..1.0).contains(&beta1) || !(0.0..1.0).contains(&beta2) {
+                    return bad(format!(
+                        "Adam betas must be in [0, 1), got {beta1}, {beta2}"
+                    ));
+                }
+                if !(eps > 0.0 && eps.is_finite()) {
+                    return bad(format!("Adam eps must be > 0, got {eps}"));
+                }
+            }
+            Optimizer::Sgd { lr, momentum } => {
+                if !(lr > 0.0 && lr.is_finite()) {
+                    return bad(format!(
+                        "SGD learning rate must be > 0 and finite, got {lr}"
+                    ));
+                }
+                if !(0.0..1.0).contains(&momentum) {
+                    return bad(format!("SGD momentum must be in [0, 1), got {momentum}"));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Default for Optimizer {
+    fn default() -> Self {
+        Optimizer::adam()
+    }
+}
+
+/// How the windows used for early stopping are held out.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "by", rename_all = "snake_case")]
+pub enum ValidationSplit {
+    /// Hold out whole trials (default): about `fraction` of the trials, chosen so that every
+    /// label (finger × direction, or rest) keeps at least one trial for training. Honest:
+    /// held-out windows share no samples with training windows.
+    Trial {
+        /// Fraction of trials held out, in (0, 1).
+        fraction: f64,
+    },
+    /// Hold out random windows. **Leaky**: windows overlap 75%, so held-out windows are near
+    /// copies of training windows and early stopping stops late. Offered only to reproduce the
+    /// paper's protocol.
+    Window {
+        /// Fraction of windows held out, in (0, 1).
+        fraction: f64,
+    },
+    /// No held-out data: train for `max_epochs` and keep the last weights.
+    None,
+}
+
+impl Default for ValidationSplit {
+    fn default() -> Self {
+        ValidationSplit::Trial { fraction: 0.2 }
+    }
+}
+
+/// All training settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct TrainConfig {
+    /// Step rule (default Adam).
+    pub optimizer: Optimizer,
+    /// Windows per mini-batch (default 32).
+    pub batch_size: usize,
+    /// Upper bound on epochs (default 200).
+    pub max_epochs: usize,
+    /// Epochs without validation improvement before stopping (default 20).
+    pub patience: usize,
+    /// Smallest decrease of the validation loss that counts as an improvement (default 1e-6).
+    pub min_delta: f64,
+    /// Held-out split for early stopping (default: 20% of trials).
+    pub split: ValidationSplit,
+    /// Seed for initialisation, split and shuffling (default 0).
+    pub seed: u64,
+}
+
+impl Default for TrainConfig {
+    fn default() -> Self {
+        TrainConfig {
+            optimizer: Optimizer::default(),
+            batch_size: 32,
+            max_epochs: 200,
+            patience: 20,
+            min_delta: 1e-6,
+            split: ValidationSplit::default(),
+            seed: 0,
+        }
+    }
+}
+
+impl TrainConfig {
+    /// Checks every field; the error names the field and its allowed range.
+    pub fn validate(&self) -> Result<(), TrainError> {
+        self.optimizer.validate()?;
+        let bad = |m: String| Err(TrainError::Config(m));
+        if self.batch_size == 0 || self.batch_size > 1 << 20 {
+            return bad(format!(
+                "batch_size must be in 1..=1048576, got {}",
+                self.batch_size
+            ));
+        }
+        if self.max_epochs == 0 || self.max_epochs > 1_000_000 {
+            return bad(format!(
+                "max_epochs must be in 1..=1000000, got {}",
+                self.max_epochs
+            ));
+        }
+        if !(self.min_delta >= 0.0 && self.min_delta.is_finite()) {
+            return bad(format!(
+                "min_delta must be >= 0 and finite, got {}",
+                self.min_delta
+            ));
+        }
+        match self.split {
+            ValidationSplit::Trial { fraction } | ValidationSplit::Window { fraction }
+                if !(fraction > 0.0 && fraction < 1.0) =>
+            {
+                bad(format!(
+                    "validation fraction must be in (0, 1), got {fraction}"
+                ))
+            }
+            _ => Ok(()),
+        }
+    }
+}

@@ -1,0 +1,366 @@
+//! The model file: versioned, self-describing, checksummed, written atomically.
+//!
+//! Layout (all integers little-endian):
+//!
+//! | bytes | content |
+//! |---|---|
+//! | 8 | magic `HSMODEL\n` |
+//! | 4 | format version (u32, currently [`FORMAT_VERSION`]) |
+//! | 4 | CRC-32 (IEEE) of the body |
+//! | 8 | body length in bytes (u64) |
+//! | body | u64 metadata length, metadata (UTF-8 JSON), parameters (f64), normalizer scales (f64) |
+//!
+//! The JSON metadata names everything a reader needs: model kind and hyper-parameters, input and
+//! output sizes, sample rate, channel count, feature names, the full signal chain configuration,
+//! the list of parameter tensors (name and shape, in storage order), the normalizer's shape and
+//! the training summary. Weights are raw IEEE-754 doubles so they load bit for bit.
+//!
+//! Loading checks, in this order, each with its own [`FileError`]: magic, version, length,
+//! checksum, metadata, tensor shapes against the kind and spec, finite weights, the chain
+//! configuration against the one in use.
+
+use std::fs::{self, File};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::dsp::{ChainConfig, FEATURES_PER_CHANNEL, FEATURE_NAMES};
+
+use super::any::AnyModel;
+use super::dataset::N_FINGERS;
+use super::error::FileError;
+use super::kind::ModelKind;
+use super::normalizer::Normalizer;
+use super::spec::ModelSpec;
+use super::train::TrainingSummary;
+use super::trained::TrainedModel;
+use super::traits::{Model, Trainable};
+
+/// Magic bytes at the start of every model file.
+pub const MAGIC: [u8; 8] = *b"HSMODEL\n";
+/// The format version this build writes and reads.
+pub const FORMAT_VERSION: u32 = 1;
+/// Header length in bytes.
+pub const HEADER_LEN: usize = 24;
+/// Name of the normalizer tensor in the metadata and in errors.
+pub const NORMALIZER_TENSOR: &str = "normalizer.scale";
+
+/// Name and shape of one stored tensor.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+struct TensorMeta {
+    name: String,
+    shape: Vec<usize>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Meta {
+    format: String,
+    kind: ModelKind,
+    spec: ModelSpec,
+    n_inputs: usize,
+    n_outputs: usize,
+    sample_rate_hz: f64,
+    n_channels: usize,
+    feature_names: Vec<String>,
+    chain: serde_json::Value,
+    tensors: Vec<TensorMeta>,
+    normalizer: TensorMeta,
+    summary: TrainingSummary,
+}
+
+const FORMAT_NAME: &str = "handstack-model";
+
+fn io_err<'a>(op: &'static str, path: &'a Path) -> impl FnOnce(std::io::Error) -> FileError + 'a {
+    move |source| FileError::Io {
+        op,
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+/// Top-level fields of two JSON objects that differ (both directions).
+fn differing_fields(a: &serde_json::Value, b: &serde_json::Value) -> Vec<String> {
+    match (a.as_object(), b.as_object()) {
+        (Some(x), Some(y)) => {
+            let mut keys: Vec<&String> = x.keys().chain(y.keys()).collect();
+            keys.sort();
+            keys.dedup();
+            keys.into_iter()
+                .filter(|k| x.get(*k) != y.get(*k))
+                .map(|k| k.to_string())
+                .collect()
+        }
+        _ => vec!["<whole configuration>".into()],
+    }
+}
+
+impl TrainedModel {
+    /// The file contents (see the module docs). Errors only if the model holds a non-finite
+    /// value (which its constructors prevent) or the metadata cannot be serialised.
+    pub fn to_bytes(&self) -> Result<Vec<u8>, FileError> {
+        let params = self.model.params();
+        let tensors = self.model.tensors();
+        for t in &tensors {
+            if let Some(index) = params[t.offset..t.offset + t.len()]
+                .iter()
+                .position(|p| !p.is_finite())
+            {
+                return Err(FileError::NonFiniteWeight {
+                    tensor: t.name.clone(),
+                    index,
+                });
+            }
+        }
+        let chain =
+            serde_json::to_value(&self.chain).map_err(|e| FileError::Malformed(e.to_string()))?;
+        let meta = Meta {
+            format: FORMAT_NAME.into(),
+            kind: self.model.kind(),
+            spec: self.spec,
+            n_inputs: self.model.n_inputs(),
+            n_outputs: self.model.n_outputs(),
+            sample_rate_hz: self.chain.sample_rate_hz,
+            n_channels: self.chain.channels,
+            feature_names: (0..self.chain.channels)
+                .flat_map(|c| FEATURE_NAMES.iter().map(move |f| format!("ch{c}.{f}")))
+                .collect(),
+            chain,
+            tensors: tensors
+                .iter()
+                .map(|t| TensorMeta {
+                    name: t.name.clone(),
+                    shape: t.shape.clone(),
+                })
+                .collect(),
+            normalizer: TensorMeta {
+                name: NORMALIZER_TENSOR.into(),
+                shape: vec![self.normalizer.len()],
+            },
+            summary: self.summary.clone(),
+        };
+        let meta_json =
+            serde_json::to_vec_pretty(&meta).map_err(|e| FileError::Malformed(e.to_string()))?;
+        let mut body =
+            Vec::with_capacity(8 + meta_json.len() + 8 * (params.len() + self.normalizer.len()));
+        body.extend_from_slice(&(meta_json.len() as u64).to_le_bytes());
+        body.extend_from_slice(&meta_json);
+        for p in params.iter().chain(self.normalizer.scales()) {
+            body.extend_from_slice(&p.to_le_bytes());
+        }
+        let mut out = Vec::with_capacity(HEADER_LEN + body.len());
+        out.extend_from_slice(&MAGIC);
+        out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+        out.extend_from_slice(&crc32fast::hash(&body).to_le_bytes());
+        out.extend_from_slice(&(body.len() as u64).to_le_bytes());
+        out.extend_from_slice(&body);
+        Ok(out)
+    }
+
+    /// Parses and checks file contents (see the module docs). With `expected_chain`, a model
+    /// trained on a different signal chain configuration is refused, naming the fields that differ.
+    pub fn from_bytes(
+        bytes: &[u8],
+        expected_chain: Option<&ChainConfig>,
+    ) -> Result<Self, FileError> {
+        if bytes.len() < HEADER_LEN || bytes[..8] != MAGIC {
+            return Err(FileError::NotAModelFile);
+        }
+        let word = |r: std::ops::Range<usize>| -> [u8; 4] { bytes[r].try_into().expect("4 bytes") };
+        let version = u32::from_le_bytes(word(8..12));
+        if version != FORMAT_VERSION {
+            return Err(FileError::UnknownVersion {
+                found: version,
+                supported: FORMAT_VERSION,
+            });
+        }
+        let stored_crc = u32::from_le_bytes(word(12..16));
+        let body_len = u64::from_le_bytes(bytes[16..24].try_into().expect("8 bytes"));
+        let body = &bytes[HEADER_LEN..];
+        if body.len() as u64 != body_len {
+            return Err(FileError::Length {
+                expected: body_len,
+                found: body.len() as u64,
+            });
+        }
+        let computed = crc32fast::hash(body);
+        if computed != stored_crc {
+            return Err(FileError::BadChecksum {
+                stored: stored_crc,
+                computed,
+            });
+        }
+        let malformed = |m: String| FileError::Malformed(m);
+        if body.len() < 8 {
+            return Err(malformed("body too short for the metadata length".into()));
+        }
+        let meta_len = u64::from_le_bytes(body[..8].try_into().expect("8 bytes"));
+        let rest = &body[8..];
+        if meta_len > rest.len() as u64 {
+            return Err(malformed(format!(
+                "metadata length {meta_len} exceeds the {} bytes present",
+                rest.len()
+            )));
+        }
+        let (meta_bytes, data) = rest.split_at(meta_len as usize);
+        let meta: Meta =
+            serde_json::from_slice(meta_bytes).map_err(|e| malformed(format!("metadata: {e}")))?;
+        if meta.format != FORMAT_NAME {
+            return Err(malformed(format!(
+                "format name {:?}, expected {FORMAT_NAME:?}",
+                meta.format
+            )));
+        }
+        let chain: ChainConfig = serde_json::from_value(meta.chain.clone())
+            .map_err(|e| malformed(format!("signal chain configuration: {e}")))?;
+        chain
+            .validate()
+            .map_err(|e| malformed(format!("signal chain configuration: {e}")))?;
+        if meta.n_channels != chain.channels || meta.sample_rate_hz != chain.sample_rate_hz {
+            return Err(malformed(format!(
+                "header says {} channels at {} Hz, the chain configuration {} at {} Hz",
+                meta.n_channels, meta.sample_rate_hz, chain.channels, chain.sample_rate_hz
+            )));
+        }
+        let n_in = FEATURES_PER_CHANNEL * chain.channels;
+        if meta.n_inputs != n_in {
+            return Err(FileError::WrongShape {
+                tensor: "input".into(),
+                expected: vec![n_in],
+                found: vec![meta.n_inputs],
+            });
+        }
+        if meta.n_outputs != N_FINGERS {
+            return Err(FileError::WrongShape {
+                tensor: "output".into(),
+                expected: vec![N_FINGERS],
+                found: vec![meta.n_outputs],
+            });
+        }
+        let expected = AnyModel::expected_tensors(meta.kind, &meta.spec, n_in, N_FINGERS)?;
+        for i in 0..expected.len().max(meta.tensors.len()) {
+            match (expected.get(i), meta.tensors.get(i)) {
+                (Some(e), Some(f)) if e.name == f.name && e.shape == f.shape => {}
+                (Some(e), f) => {
+                    return Err(FileError::WrongShape {
+                        tensor: e.name.clone(),
+                        expected: e.shape.clone(),
+                        found: f.map(|f| f.shape.clone()).unwrap_or_default(),
+                    })
+                }
+                (None, Some(f)) => {
+                    return Err(FileError::WrongShape {
+                        tensor: f.name.clone(),
+                        expected: Vec::new(),
+                        found: f.shape.clone(),
+                    })
+                }
+                (None, None) => unreachable!("loop bound is the longer list"),
+            }
+        }
+        if meta.normalizer.name != NORMALIZER_TENSOR || meta.normalizer.shape != [n_in] {
+            return Err(FileError::WrongShape {
+                tensor: NORMALIZER_TENSOR.into(),
+                expected: vec![n_in],
+                found: meta.normalizer.shape.clone(),
+            });
+        }
+        let n_params: usize = expected.iter().map(|t| t.len()).sum();
+        let want_bytes = 8 * (n_params as u64 + n_in as u64);
+        if data.len() as u64 != want_bytes {
+            return Err(malformed(format!(
+                "weight data is {} bytes, the tensors need {want_bytes}",
+                data.len()
+            )));
+        }
+        let values: Vec<f64> = data
+            .chunks_exact(8)
+            .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
+            .collect();
+        let (params, scales) = values.split_at(n_params);
+        for t in &expected {
+            if let Some(index) = params[t.offset..t.offset + t.len()]
+                .iter()
+                .position(|p| !p.is_finite())
+            {
+                return Err(FileError::NonFiniteWeight {
+                    tensor: t.name.clone(),
+                    index,
+                });
+            }
+        }
+        if let Some(index) = scales.iter().position(|s| !s.is_finite() || *s < 0.0) {
+            return Err(FileError::NonFiniteWeight {
+                tensor: NORMALIZER_TENSOR.into(),
+                index,
+            });
+        }
+        if let Some(exp) = expected_chain {
+            if *exp != chain {
+                let want = serde_json::to_value(exp).map_err(|e| malformed(e.to_string()))?;
+                return Err(FileError::ChainMismatch {
+                    fields: differing_fields(&meta.chain, &want),
+                });
+            }
+        }
+        if meta.summary.kind != meta.kind {
+            return Err(malformed(format!(
+                "training summary is for {}, the model is {}",
+                meta.summary.kind, meta.kind
+            )));
+        }
+        let model = AnyModel::from_params(meta.kind, &meta.spec, n_in, N_FINGERS, params.to_vec())?;
+        let normalizer = Normalizer::from_scales(scales.to_vec())?;
+        Ok(TrainedModel::new(
+            model,
+            meta.spec,
+            normalizer,
+            chain,
+            meta.summary,
+        )?)
+    }
+
+    /// Writes the model atomically: a temporary file in the same directory, fsync, rename over
+    /// `path`, fsync of the directory. A crash leaves either the old file or the new one.
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), FileError> {
+        let path = path.as_ref();
+        let bytes = self.to_bytes()?;
+        let dir = match path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let name = path
+            .file_name()
+            .ok_or_else(|| FileError::Malformed(format!("{} has no file name", path.display())))?;
+        let tmp = dir.join(format!(
+            ".{}.tmp-{}",
+            name.to_string_lossy(),
+            std::process::id()
+        ));
+        let write = || -> Result<(), FileError> {
+            let mut f = File::create(&tmp).map_err(io_err("create", &tmp))?;
+            f.write_all(&bytes).map_err(io_err("write", &tmp))?;
+            f.sync_all().map_err(io_err("fsync", &tmp))?;
+            fs::rename(&tmp, path).map_err(io_err("rename into", path))?;
+            File::open(&dir)
+                .and_then(|d| d.sync_all())
+                .map_err(io_err("fsync directory", &dir))
+        };
+        let result = write();
+        if result.is_err() {
+            // Best effort: never leave a stray temporary behind; the original error matters more.
+            let _ = fs::remove_file(&tmp);
+        }
+        result
+    }
+
+    /// Reads and checks a model file; see [`TrainedModel::from_bytes`].
+    pub fn load(
+        path: impl AsRef<Path>,
+        expected_chain: Option<&ChainConfig>,
+    ) -> Result<Self, FileError> {
+        let path = path.as_ref();
+        let bytes = fs::read(path).map_err(io_err("read", path))?;
+        Self::from_bytes(&bytes, expected_chain)
+    }
+}

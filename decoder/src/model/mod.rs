@@ -1,0 +1,50 @@
+//! Models that map a feature vector to five finger labels, their training, and model files.
+//!
+//! - Architectures ([`ResDd`], LN and MLP as [`DenseNet`], [`Cnn`]; [`AnyModel`] picks one at
+//!   run time) share the [`Model`] trait (allocation-free inference with a caller-owned
+//!   [`Scratch`]) and the [`Trainable`] trait (flat parameters and an analytic gradient).
+//! - [`Normalizer`]: per-feature scale, no centring, so zero input stays zero.
+//! - [`Dataset`] + [`train`]: masked MSE, Adam or SGD, early stopping on held-out trials,
+//!   deterministic for a given seed.
+//! - [`TrainedModel`]: what a model file holds ([`TrainedModel::save`] / [`TrainedModel::load`]);
+//!   [`Predictor`] runs it in the daemon's tick.
+//!
+//! Numbers are `f64` throughout; matrices are row-major plain slices (no nalgebra): one flat
+//! parameter vector per model keeps optimizers and the file format uniform and makes it easy to
+//! guarantee that inference never allocates.
+
+mod any;
+mod cnn;
+mod config;
+mod dataset;
+mod dense;
+mod error;
+mod file;
+mod init;
+mod kind;
+mod linalg;
+mod normalizer;
+mod optim;
+mod resdd;
+mod spec;
+mod split;
+mod train;
+mod trained;
+mod traits;
+
+pub use any::AnyModel;
+pub use cnn::Cnn;
+pub use config::{Optimizer, TrainConfig, ValidationSplit};
+pub use dataset::{Dataset, N_FINGERS};
+pub use dense::DenseNet;
+pub use error::{FileError, ModelError, TrainError};
+pub use file::{FORMAT_VERSION, HEADER_LEN, MAGIC, NORMALIZER_TENSOR};
+pub use kind::ModelKind;
+pub use normalizer::Normalizer;
+pub use resdd::{ResDd, ResDdActivations, RESDD_INPUT_GAIN};
+pub use spec::{
+    CnnSpec, LnSpec, MlpSpec, ModelSpec, ResDdSpec, ResDdVariant, MAX_MODULES, MAX_WIDTH,
+};
+pub use train::{train, EpochReport, TrainingSummary};
+pub use trained::{Predictor, TrainedModel};
+pub use traits::{Model, Scratch, TensorInfo, Trainable};

@@ -1,0 +1,96 @@
+//! The held-out split for early stopping.
+
+use std::collections::BTreeMap;
+
+use super::config::ValidationSplit;
+use super::dataset::{Dataset, N_FINGERS};
+use super::error::TrainError;
+use super::init::SeededRng;
+
+/// Window indices for training and validation.
+pub(crate) struct Split {
+    pub(crate) train: Vec<usize>,
+    pub(crate) val: Vec<usize>,
+}
+
+/// The label signature of a window: its targets and mask, bit-exact.
+fn label_key(d: &Dataset, i: usize) -> [u64; N_FINGERS] {
+    let (t, m) = (d.target(i), d.mask(i));
+    std::array::from_fn(|f| if m[f] { t[f].to_bits() } else { u64::MAX })
+}
+
+pub(crate) fn make_split(
+    d: &Dataset,
+    how: ValidationSplit,
+    rng: &mut SeededRng,
+) -> Result<Split, TrainError> {
+    let n = d.len();
+    match how {
+        ValidationSplit::None => Ok(Split {
+            train: (0..n).collect(),
+            val: Vec::new(),
+        }),
+        ValidationSplit::Window { fraction } => {
+            if n < 2 {
+                return Err(TrainError::Split(format!(
+                    "need at least 2 windows, have {n}"
+                )));
+            }
+            let mut idx: Vec<usize> = (0..n).collect();
+            rng.shuffle(&mut idx);
+            let n_val = ((fraction * n as f64).round() as usize).clamp(1, n - 1);
+            let mut val = idx[..n_val].to_vec();
+            let mut train = idx[n_val..].to_vec();
+            val.sort_unstable();
+            train.sort_unstable();
+            Ok(Split { train, val })
+        }
+        ValidationSplit::Trial { fraction } => {
+            // Trial -> label of its first window; label -> number of trials still in training.
+            let mut trial_label: BTreeMap<usize, [u64; N_FINGERS]> = BTreeMap::new();
+            for i in 0..n {
+                trial_label
+                    .entry(d.trial(i))
+                    .or_insert_with(|| label_key(d, i));
+            }
+            let mut left: BTreeMap<[u64; N_FINGERS], usize> = BTreeMap::new();
+            for key in trial_label.values() {
+                *left.entry(*key).or_insert(0) += 1;
+            }
+            let mut trials: Vec<usize> = trial_label.keys().copied().collect();
+            let n_trials = trials.len();
+            let want = ((fraction * n_trials as f64).round() as usize).max(1);
+            rng.shuffle(&mut trials);
+            let mut held = Vec::new();
+            for t in trials {
+                if held.len() == want {
+                    break;
+                }
+                let c = left
+                    .get_mut(&trial_label[&t])
+                    .expect("every label was counted");
+                if *c > 1 {
+                    *c -= 1;
+                    held.push(t);
+                }
+            }
+            if held.is_empty() {
+                return Err(TrainError::Split(format!(
+                    "no trial can be held out without losing a label ({n_trials} trials, every \
+                     finger/direction has a single trial): record repetitions, or choose the \
+                     window split (leaky) or no split"
+                )));
+            }
+            held.sort_unstable();
+            let (mut train, mut val) = (Vec::new(), Vec::new());
+            for i in 0..n {
+                if held.binary_search(&d.trial(i)).is_ok() {
+                    val.push(i);
+                } else {
+                    train.push(i);
+                }
+            }
+            Ok(Split { train, val })
+        }
+    }
+}

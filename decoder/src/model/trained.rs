@@ -1,0 +1,144 @@
+//! A trained decoder as deployed: the model, its normalizer, the signal chain configuration its
+//! features came from, and what training did. [`Predictor`] runs it in the daemon's tick.
+
+use crate::dsp::{ChainConfig, FEATURES_PER_CHANNEL};
+
+use super::any::AnyModel;
+use super::dataset::N_FINGERS;
+use super::error::ModelError;
+use super::normalizer::Normalizer;
+use super::spec::ModelSpec;
+use super::train::TrainingSummary;
+use super::traits::{Model, Scratch, Trainable};
+
+/// Model + normalizer + chain configuration + training summary (what a model file holds).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrainedModel {
+    pub(crate) model: AnyModel,
+    pub(crate) spec: ModelSpec,
+    pub(crate) normalizer: Normalizer,
+    pub(crate) chain: ChainConfig,
+    pub(crate) summary: TrainingSummary,
+}
+
+impl TrainedModel {
+    /// Bundles the parts, checking that they fit together: 5 outputs, the model's tensors match
+    /// `spec`, and model input = normalizer length = 8 × the chain's channels.
+    pub fn new(
+        model: AnyModel,
+        spec: ModelSpec,
+        normalizer: Normalizer,
+        chain: ChainConfig,
+        summary: TrainingSummary,
+    ) -> Result<Self, ModelError> {
+        let n_in = FEATURES_PER_CHANNEL * chain.channels;
+        let shape = |what: &str, expected: usize, found: usize| {
+            if expected == found {
+                Ok(())
+            } else {
+                Err(ModelError::Shape {
+                    what: what.to_string(),
+                    expected,
+                    found,
+                })
+            }
+        };
+        shape("model inputs (8 x chain channels)", n_in, model.n_inputs())?;
+        shape("normalizer length", n_in, normalizer.len())?;
+        shape("model outputs (fingers)", N_FINGERS, model.n_outputs())?;
+        let expected = AnyModel::expected_tensors(model.kind(), &spec, n_in, N_FINGERS)?;
+        if expected != model.tensors() {
+            return Err(ModelError::InvalidSpec(format!(
+                "the {} model's tensors do not match its specification",
+                model.kind()
+            )));
+        }
+        if summary.kind != model.kind() {
+            return Err(ModelError::InvalidSpec(format!(
+                "training summary is for a {} model, the model is {}",
+                summary.kind,
+                model.kind()
+            )));
+        }
+        Ok(TrainedModel {
+            model,
+            spec,
+            normalizer,
+            chain,
+            summary,
+        })
+    }
+
+    /// The model.
+    pub fn model(&self) -> &AnyModel {
+        &self.model
+    }
+    /// Hyper-parameters the model was built with.
+    pub fn spec(&self) -> &ModelSpec {
+        &self.spec
+    }
+    /// The feature scaling.
+    pub fn normalizer(&self) -> &Normalizer {
+        &self.normalizer
+    }
+    /// The signal chain configuration the model was trained on (features must come from it).
+    pub fn chain(&self) -> &ChainConfig {
+        &self.chain
+    }
+    /// Sample rate of the training data in Hz.
+    pub fn sample_rate_hz(&self) -> f64 {
+        self.chain.sample_rate_hz
+    }
+    /// EMG channel count.
+    pub fn n_channels(&self) -> usize {
+        self.chain.channels
+    }
+    /// What training did.
+    pub fn summary(&self) -> &TrainingSummary {
+        &self.summary
+    }
+
+    /// Labels for one raw feature vector (normalized here). Allocates; for offline use — the
+    /// daemon uses a [`Predictor`].
+    pub fn predict(&self, features: &[f64]) -> [f64; N_FINGERS] {
+        self.predictor().run(features)
+    }
+
+    /// A reusable, allocation-free runner (allocates its buffers once, here).
+    pub fn predictor(&self) -> Predictor {
+        Predictor {
+            model: self.model.clone(),
+            normalizer: self.normalizer.clone(),
+            scratch: self.model.new_scratch(),
+            xn: vec![0.0; self.normalizer.len()],
+        }
+    }
+}
+
+/// Runs a trained model on raw feature vectors without allocating: normalize, then predict.
+#[derive(Debug, Clone)]
+pub struct Predictor {
+    model: AnyModel,
+    normalizer: Normalizer,
+    scratch: Scratch,
+    xn: Vec<f64>,
+}
+
+impl Predictor {
+    /// Features expected per call.
+    pub fn n_inputs(&self) -> usize {
+        self.xn.len()
+    }
+
+    /// Finger labels for `features` (length [`Predictor::n_inputs`], panics otherwise: the chain
+    /// that feeds it is built from the same configuration, so a mismatch is a wiring bug).
+    /// No allocation, no `Result`. Non-finite features give non-finite labels; the chain
+    /// reports such input as a fault before it gets here.
+    #[inline]
+    pub fn run(&mut self, features: &[f64]) -> [f64; N_FINGERS] {
+        self.normalizer.apply(features, &mut self.xn);
+        let mut y = [0.0; N_FINGERS];
+        self.model.predict_with(&self.xn, &mut y, &mut self.scratch);
+        y
+    }
+}
