@@ -1,46 +1,28 @@
-//! TEMPORARY stand-in until hand-dbc exports CanFrame and the messages.
-#![allow(missing_docs)]
+//! The few things the simulator takes from hand.dbc beyond the generated messages, and the
+//! E2E sealing every node uses.
 
-use embedded_can::{Frame, Id};
+use hand_dbc::e2e::E2eProfile;
+pub use hand_dbc::CanFrame;
 
-pub const EMG_LSB_UV: f64 = 2.5;
+/// ADC resolution of the EMG signals: µV per count (hand.dbc EMG_SAMPLES factor).
+pub const EMG_LSB_UV: f64 = hand_dbc::messages::EmgSamplesG0::EMG0_FACTOR;
 
-#[derive(Clone, Copy, PartialEq, Eq, Debug)]
-pub struct CanFrame {
-    id: Id,
-    dlc: u8,
-    data: [u8; 8],
-}
-
-impl Frame for CanFrame {
-    fn new(id: impl Into<Id>, data: &[u8]) -> Option<Self> {
-        if data.len() > 8 {
-            return None;
-        }
-        let mut d = [0; 8];
-        d[..data.len()].copy_from_slice(data);
-        Some(Self {
-            id: id.into(),
-            dlc: data.len() as u8,
-            data: d,
-        })
+/// Writes `counter` into the alive-counter bits of byte 1 and the CRC into byte 0.
+///
+/// The nodes seal frames themselves rather than through `E2eProtector` because faults need
+/// to choose the counter (jumps, stuck counters) and the three EMG groups share one sample
+/// counter. `corrupt_crc` flips the CRC's bits, for the bad-CRC fault.
+pub fn seal(frame: &mut CanFrame, profile: E2eProfile, counter: u8, corrupt_crc: bool) {
+    let mask = if profile.counter_bits() == 8 {
+        0xFF
+    } else {
+        0x0F
+    };
+    let data = frame.data_mut();
+    if data.len() < 2 {
+        return;
     }
-    fn new_remote(_id: impl Into<Id>, _dlc: usize) -> Option<Self> {
-        None
-    }
-    fn is_extended(&self) -> bool {
-        matches!(self.id, Id::Extended(_))
-    }
-    fn is_remote_frame(&self) -> bool {
-        false
-    }
-    fn id(&self) -> Id {
-        self.id
-    }
-    fn dlc(&self) -> usize {
-        self.dlc as usize
-    }
-    fn data(&self) -> &[u8] {
-        &self.data[..self.dlc as usize]
-    }
+    data[1] = (data[1] & !mask) | (counter & mask);
+    let crc = profile.crc(data);
+    data[0] = if corrupt_crc { !crc } else { crc };
 }

@@ -7,8 +7,12 @@ pub mod clock;
 pub mod dbc;
 pub mod emg;
 pub mod error;
+pub mod faults;
 pub mod finger;
+pub mod nodes;
 pub mod patient;
+pub mod scenario;
+pub mod world;
 
 pub use bus::{MemBus, MemBusError, MemEndpoint, Received};
 pub use clock::{Clock, SystemClock, VirtualClock};

@@ -77,3 +77,64 @@ pub fn rms_ac(x: &[f64]) -> f64 {
     let mean = x.iter().sum::<f64>() / x.len() as f64;
     (x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / x.len() as f64).sqrt()
 }
+
+use hand_model::bus::{MemBus, MemEndpoint, Received};
+use hand_model::clock::VirtualClock;
+use hand_model::dbc::CanFrame;
+
+/// A virtual-clock bus with a monitor endpoint that records everything.
+pub struct Harness {
+    pub clock: VirtualClock,
+    pub bus: MemBus,
+    pub monitor: MemEndpoint,
+    pub log: Vec<Received>,
+}
+
+impl Harness {
+    pub fn new() -> Self {
+        let clock = VirtualClock::new();
+        let bus = MemBus::with_clock(clock.clone()).with_capacity(1 << 20);
+        let monitor = bus.endpoint();
+        Self {
+            clock,
+            bus,
+            monitor,
+            log: Vec::new(),
+        }
+    }
+
+    /// Runs `step(t)` every millisecond from the clock's time up to `until_us`, recording
+    /// every frame seen by the monitor.
+    pub fn run(&mut self, until_us: u64, mut step: impl FnMut(u64)) {
+        let mut t = self.clock.now_us_value();
+        while t <= until_us {
+            self.clock.set_us(t);
+            step(t);
+            while let Some(r) = self.monitor.receive_timestamped() {
+                self.log.push(r);
+            }
+            t += 1000;
+        }
+    }
+
+    /// Recorded frames with id `id`, with receive times.
+    pub fn with_id(&self, id: u32) -> Vec<(u64, CanFrame)> {
+        self.log
+            .iter()
+            .filter(|r| r.frame.raw_id() == id)
+            .map(|r| (r.time_us.expect("the harness bus has a clock"), r.frame))
+            .collect()
+    }
+}
+
+/// `Clock::now_us` without importing the trait in every test.
+pub trait NowUs {
+    fn now_us_value(&self) -> u64;
+}
+
+impl NowUs for VirtualClock {
+    fn now_us_value(&self) -> u64 {
+        use hand_model::clock::Clock;
+        self.now_us()
+    }
+}

@@ -1,0 +1,250 @@
+//! A finger's motor controller on the bus: obeys FINGER_SETPOINT_f, reports FINGER_STATUS_f,
+//! and brakes by itself when valid setpoints stop.
+//!
+//! Every setpoint goes through an E2E check (CRC with the message's data id, alive counter).
+//! Only a frame classified OK refreshes the setpoint watchdog; a bad CRC, a repeated (stuck)
+//! counter or a counter jump does not, and raises the E2E fault bit. When no valid setpoint
+//! arrived for `setpoint_timeout_us` (150 ms), the brake engages: velocity and force go to
+//! zero at once, the state becomes BRAKED and fault bit 3 is set, so a killed daemon leaves a
+//! safe hand. A valid HAND_ESTOP STOP also brakes, until a valid RELEASE. Valid setpoints
+//! release a timeout brake (the first frame after a gap resynchronises the counter, so it
+//! takes two).
+
+use hand_dbc::e2e::E2eChecker;
+use hand_dbc::e2e::E2eStatus;
+use hand_dbc::messages::{self, EstopRequest, FingerSetpoint, FingerStatus, HandEstop};
+
+use super::{std_id, Bus, NodeStats};
+use crate::dbc::seal;
+use crate::error::SimError;
+use crate::faults::{CrcTarget, Fault, FaultPlan};
+use crate::finger::{Command, FingerConfig, FingerMode, FingerPhysics, FingerState, N_FINGERS};
+
+/// FINGER_STATUS fault bit 3: setpoint timeout, braked.
+pub const FAULT_SETPOINT_TIMEOUT: u8 = 1 << 3;
+/// FINGER_STATUS fault bit 4: E2E error on setpoints since the previous status.
+pub const FAULT_SETPOINT_E2E: u8 = 1 << 4;
+/// FINGER_STATUS fault bit 5: at a joint limit.
+pub const FAULT_JOINT_LIMIT: u8 = 1 << 5;
+
+/// Counter steps accepted between two setpoints: one lost frame is tolerated.
+const SETPOINT_MAX_DELTA: u16 = 2;
+
+/// One finger and its motor controller.
+#[derive(Debug, Clone)]
+pub struct FingerNode {
+    finger: usize,
+    cfg: FingerConfig,
+    phys: FingerPhysics,
+    cmd: Command,
+    checker: E2eChecker,
+    last_valid_us: Option<u64>,
+    ever_valid: bool,
+    timed_out: bool,
+    estop: bool,
+    e2e_errors_since_status: bool,
+    e2e_errors: u64,
+    last_step_us: u64,
+    next_status_us: u64,
+    status_counter: u8,
+    status_frames: u64,
+    faults: FaultPlan,
+    stats: NodeStats,
+}
+
+impl FingerNode {
+    /// The controller of finger `finger` (0 thumb ..= 4 pinky), starting at full extension
+    /// (`angle_min_rad`), disabled and braked until the first valid setpoint.
+    pub fn try_new(finger: usize, cfg: FingerConfig, start_us: u64) -> Result<Self, SimError> {
+        if finger >= N_FINGERS {
+            return Err(SimError::BadFinger(finger));
+        }
+        cfg.validate()?;
+        let checker = E2eChecker::try_new(FingerSetpoint::E2E[finger], SETPOINT_MAX_DELTA)
+            .map_err(|e| SimError::BadScript(format!("setpoint E2E profile: {e}")))?;
+        Ok(Self {
+            finger,
+            phys: FingerPhysics::at(cfg.angle_min_rad),
+            cfg,
+            cmd: Command::default(),
+            checker,
+            last_valid_us: None,
+            ever_valid: false,
+            timed_out: false,
+            estop: false,
+            e2e_errors_since_status: false,
+            e2e_errors: 0,
+            last_step_us: start_us,
+            next_status_us: start_us,
+            status_counter: 0,
+            status_frames: 0,
+            faults: FaultPlan::new(),
+            stats: NodeStats::default(),
+        })
+    }
+
+    /// Replaces the fault plan.
+    pub fn set_faults(&mut self, faults: FaultPlan) {
+        self.faults = faults;
+    }
+
+    /// The finger index.
+    pub fn finger(&self) -> usize {
+        self.finger
+    }
+
+    /// The mechanical state.
+    pub fn physics(&self) -> &FingerPhysics {
+        &self.phys
+    }
+
+    /// The state that FINGER_STATUS reports now.
+    pub fn state(&self) -> FingerState {
+        if self.estop || self.timed_out {
+            FingerState::Braked
+        } else if !self.ever_valid {
+            FingerState::Disabled
+        } else {
+            match self.cmd.mode {
+                FingerMode::Disabled => FingerState::Disabled,
+                FingerMode::Active => FingerState::Active,
+                FingerMode::Hold => FingerState::Hold,
+                FingerMode::SafeStop => FingerState::SafeStop,
+            }
+        }
+    }
+
+    /// True while the brake is engaged by the controller itself (timeout or E-stop).
+    pub fn braked(&self) -> bool {
+        self.estop || self.timed_out || !self.ever_valid
+    }
+
+    /// Setpoints rejected by the E2E check so far.
+    pub fn e2e_errors(&self) -> u64 {
+        self.e2e_errors
+    }
+
+    /// Transmit and receive counts.
+    pub fn stats(&self) -> NodeStats {
+        self.stats
+    }
+
+    /// Reads setpoints and E-stops, runs the control loop up to `now_us`, sends status.
+    pub fn poll<B: Bus>(&mut self, now_us: u64, bus: &mut B) {
+        while let Some(frame) = self.stats.receive(bus) {
+            self.on_frame(now_us, &frame);
+        }
+        let dt_us = self.cfg.control_period_us;
+        while self.last_step_us + dt_us <= now_us {
+            self.last_step_us += dt_us;
+            let t = self.last_step_us;
+            self.timed_out = self
+                .last_valid_us
+                .is_some_and(|l| t.saturating_sub(l) >= self.cfg.setpoint_timeout_us);
+            let braked = self.braked();
+            self.phys
+                .step(&self.cfg, &self.cmd, braked, dt_us as f64 * 1e-6);
+        }
+        while self.next_status_us <= now_us {
+            let t = self.next_status_us;
+            self.send_status(t, bus);
+            self.next_status_us += self.cfg.status_period_us;
+        }
+    }
+
+    fn on_frame(&mut self, now_us: u64, frame: &hand_dbc::CanFrame) {
+        let id = std_id(frame);
+        if id == FingerSetpoint::IDS[self.finger] {
+            let status = self.checker.check_frame(Some(frame));
+            let decoded = messages::FingerSetpoint::decode(id, frame.data());
+            match (status, decoded) {
+                (E2eStatus::Ok, Ok(sp)) => {
+                    self.cmd = Command {
+                        mode: match sp.mode() {
+                            messages::FingerMode::Disabled => FingerMode::Disabled,
+                            messages::FingerMode::Active => FingerMode::Active,
+                            messages::FingerMode::Hold => FingerMode::Hold,
+                            messages::FingerMode::SafeStop => FingerMode::SafeStop,
+                        },
+                        force_n: sp.force(),
+                        velocity_rad_s: sp.velocity(),
+                    };
+                    self.last_valid_us = Some(now_us);
+                    self.ever_valid = true;
+                    self.timed_out = false;
+                }
+                _ => {
+                    self.e2e_errors += 1;
+                    self.e2e_errors_since_status = true;
+                }
+            }
+        } else if id == HandEstop::ID {
+            // Several senders interleave counters on HAND_ESTOP (hand.dbc): only the CRC
+            // decides whether to believe it.
+            let data = frame.data();
+            let crc_ok = data.len() == HandEstop::DLC && data[0] == HandEstop::E2E.crc(data);
+            if let (true, Ok(e)) = (crc_ok, HandEstop::decode(data)) {
+                self.estop = e.request() == EstopRequest::Stop;
+            }
+        }
+    }
+
+    fn send_status<B: Bus>(&mut self, t: u64, bus: &mut B) {
+        self.status_frames += 1;
+        let mut silent = false;
+        let mut bad_crc = false;
+        for (_, f) in self.faults.active(t) {
+            match f {
+                Fault::MotorSilent { finger } if finger == self.finger => silent = true,
+                Fault::BadCrc {
+                    target: CrcTarget::FingerStatus(finger),
+                    every,
+                } if finger == self.finger => {
+                    bad_crc |= self.status_frames.is_multiple_of(u64::from(every))
+                }
+                _ => {}
+            }
+        }
+        let mut faults = 0u8;
+        if self.timed_out {
+            faults |= FAULT_SETPOINT_TIMEOUT;
+        }
+        if self.e2e_errors_since_status {
+            faults |= FAULT_SETPOINT_E2E;
+        }
+        if self.phys.at_limit {
+            faults |= FAULT_JOINT_LIMIT;
+        }
+        self.e2e_errors_since_status = false;
+        let counter = self.status_counter;
+        self.status_counter = (counter + 1) & 0x0F;
+        if silent {
+            return;
+        }
+        let state = match self.state() {
+            FingerState::Disabled => messages::FingerState::Disabled,
+            FingerState::Active => messages::FingerState::Active,
+            FingerState::Hold => messages::FingerState::Hold,
+            FingerState::SafeStop => messages::FingerState::SafeStop,
+            FingerState::Braked => messages::FingerState::Braked,
+            FingerState::Fault => messages::FingerState::Fault,
+        };
+        // Status resolution: position 1 mrad, velocity 0.01 rad/s, force 0.025 N; the config
+        // limits are inside the DBC ranges (checked in FingerConfig::validate), so this encodes.
+        let msg = FingerStatus::new(
+            self.finger,
+            state,
+            self.phys.angle_rad,
+            self.phys.velocity_rad_s,
+            self.phys.force_n,
+            faults,
+        );
+        let Ok(msg) = msg else {
+            self.stats.tx_errors += 1;
+            return;
+        };
+        let mut frame = msg.to_frame();
+        seal(&mut frame, FingerStatus::E2E[self.finger], counter, bad_crc);
+        self.stats.transmit(bus, &frame);
+    }
+}
