@@ -94,11 +94,13 @@ impl Scenario {
             }
             Scenario::Sine => ScenarioRun {
                 scenario: self,
-                patient: PatientMode::ClosedLoop(ClosedLoopUser::try_new(TrackingConfig {
-                    target: Target::SINE_4S,
-                    seed,
-                    ..TrackingConfig::default()
-                })?),
+                patient: PatientMode::ClosedLoop(Box::new(ClosedLoopUser::try_new(
+                    TrackingConfig {
+                        target: Target::SINE_4S,
+                        seed,
+                        ..TrackingConfig::default()
+                    },
+                )?)),
                 duration_us: 40_000_000,
                 trials: Vec::new(),
             },

@@ -20,7 +20,7 @@ pub enum PatientMode {
     /// A scripted timeline (rest, calibration, gestures).
     Script(Script),
     /// A closed-loop user tracking a target with one finger.
-    ClosedLoop(ClosedLoopUser),
+    ClosedLoop(Box<ClosedLoopUser>),
 }
 
 /// The simulated world.

@@ -96,7 +96,8 @@ fn brakes_when_setpoints_have_a_bad_crc() {
     let e2e_flagged = h
         .with_id(FingerStatus::IDS[FINGER])
         .iter()
-        .filter_map(|(t, f)| (*t > STOP_AT_US).then(|| FingerStatus::decode(f.raw_id(), f.data())))
+        .filter(|(t, _)| *t > STOP_AT_US)
+        .map(|(_, f)| FingerStatus::decode(f.raw_id(), f.data()))
         .any(|s| s.expect("valid").faults() & (1 << 4) != 0);
     assert!(e2e_flagged, "E2E fault bit never reported");
 }
