@@ -20,6 +20,9 @@ pub enum SimError {
     /// A script or scenario that cannot be run as given.
     #[error("invalid script: {0}")]
     BadScript(String),
+    /// A node's bus handle could not be opened.
+    #[error("cannot open the bus: {0}")]
+    Transport(String),
     /// An unknown scenario name.
     #[error("unknown scenario {0:?}; known: {1}")]
     UnknownScenario(String, String),

@@ -12,6 +12,7 @@ pub mod finger;
 pub mod nodes;
 pub mod patient;
 pub mod scenario;
+pub mod socketcan_bus;
 pub mod world;
 
 pub use bus::{MemBus, MemBusError, MemEndpoint, Received};

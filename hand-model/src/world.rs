@@ -66,8 +66,7 @@ impl<B: Bus> World<B> {
         start_us: u64,
         mut open: impl FnMut() -> Result<B, E>,
     ) -> Result<Self, SimError> {
-        let mut open =
-            || open().map_err(|e| SimError::BadScript(format!("cannot open the bus: {e}")));
+        let mut open = || open().map_err(|e| SimError::Transport(e.to_string()));
         amp_cfg.start_us = start_us;
         let mut amp = AmplifierNode::try_new(amp_cfg)?;
         amp.set_faults(faults.clone());

@@ -1,0 +1,248 @@
+//! `handsim`: runs the simulated amplifier, motor controllers, patient and faults on a
+//! SocketCAN interface in real time (beside a real daemon), or on the in-memory bus as fast
+//! as possible (`--mem`, for tests and for a quick look at the traffic).
+
+use std::collections::BTreeMap;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use clap::Parser;
+use hand_model::bus::MemBus;
+use hand_model::clock::{Clock, SystemClock};
+use hand_model::emg::AmplifierConfig;
+use hand_model::faults::{Fault, FaultPlan};
+use hand_model::finger::FingerConfig;
+use hand_model::nodes::{AmplifierNodeConfig, Bus};
+use hand_model::scenario::Scenario;
+use hand_model::socketcan_bus::SocketCanBus;
+use hand_model::world::{NodeSelection, World};
+use hand_model::SimError;
+
+#[derive(Parser, Debug)]
+#[command(name = "handsim", version, about = "The simulated hand on a CAN bus")]
+struct Args {
+    /// SocketCAN interface to run on in real time (e.g. vcan0).
+    #[arg(long, conflicts_with = "mem")]
+    iface: Option<String>,
+    /// Run on the in-memory bus on a virtual clock, as fast as possible, and print a summary.
+    #[arg(long)]
+    mem: bool,
+    /// Scenario (see --list-scenarios).
+    #[arg(long, default_value = "rest")]
+    scenario: String,
+    /// Run for this many seconds instead of the scenario's length.
+    #[arg(long)]
+    duration: Option<f64>,
+    /// Seed of the amplifier's noise and the patient's motor noise.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Mains frequency, 50 or 60 Hz.
+    #[arg(long, default_value_t = 50)]
+    mains: u32,
+    /// A fault, `NAME[:ARGS][@FROM..UNTIL]` with times in seconds (default: the whole run),
+    /// e.g. `drop-emg:10@2..5`, `estop@3..3.5`, `motor-silent:2`. Repeatable.
+    #[arg(long = "fault")]
+    faults: Vec<String>,
+    /// Do not run the amplifier (e.g. a real one is on the bus).
+    #[arg(long)]
+    no_amplifier: bool,
+    /// Run the motor controllers of these fingers only, e.g. `013` (default: 01234; `none`).
+    #[arg(long, default_value = "01234")]
+    fingers: String,
+    /// Write the scenario's calibration trials (session.toml `[[trial]]` form) to this file.
+    #[arg(long)]
+    trials_out: Option<std::path::PathBuf>,
+    /// List the scenarios and faults, then exit.
+    #[arg(long)]
+    list_scenarios: bool,
+}
+
+fn parse_fault(spec: &str, duration_us: u64) -> Result<(Fault, u64, u64), SimError> {
+    let (name, window) = match spec.split_once('@') {
+        Some((n, w)) => (n, Some(w)),
+        None => (spec, None),
+    };
+    let fault: Fault = name.parse()?;
+    let secs = |s: &str| -> Result<u64, SimError> {
+        let v: f64 = s
+            .trim()
+            .parse()
+            .map_err(|_| SimError::BadScript(format!("fault {spec:?}: bad time {s:?}")))?;
+        if !(v.is_finite() && v >= 0.0) {
+            return Err(SimError::BadScript(format!(
+                "fault {spec:?}: bad time {s:?}"
+            )));
+        }
+        Ok((v * 1e6).round() as u64)
+    };
+    let (from, until) = match window {
+        None => (0, duration_us.max(1)),
+        Some(w) => {
+            let (a, b) = w.split_once("..").ok_or_else(|| {
+                SimError::BadScript(format!(
+                    "fault {spec:?}: window must be FROM..UNTIL seconds"
+                ))
+            })?;
+            (secs(a)?, secs(b)?)
+        }
+    };
+    Ok((fault, from, until))
+}
+
+fn parse_fingers(s: &str) -> Result<u8, SimError> {
+    if s == "none" {
+        return Ok(0);
+    }
+    let mut mask = 0u8;
+    for c in s.chars() {
+        let f = c.to_digit(10).filter(|d| *d < 5).ok_or_else(|| {
+            SimError::BadScript(format!("--fingers {s:?}: use digits 0..4 or none"))
+        })?;
+        mask |= 1 << f;
+    }
+    Ok(mask)
+}
+
+fn run() -> Result<(), String> {
+    let args = Args::parse();
+    if args.list_scenarios {
+        for s in Scenario::ALL {
+            println!("{:<18} {}", s.name(), s.description());
+        }
+        println!(
+            "\nfaults (--fault NAME[:ARGS][@FROM..UNTIL]): {}",
+            Fault::SYNTAX
+        );
+        return Ok(());
+    }
+    let scenario: Scenario = args.scenario.parse().map_err(|e: SimError| e.to_string())?;
+    let run = scenario.build(args.seed).map_err(|e| e.to_string())?;
+    let duration_us = match args.duration {
+        Some(d) if d.is_finite() && d > 0.0 => (d * 1e6).round() as u64,
+        Some(d) => {
+            return Err(format!(
+                "--duration {d}: must be a positive number of seconds"
+            ))
+        }
+        None => run.duration_us,
+    };
+    if let Some(path) = &args.trials_out {
+        let text = run.trials_toml().map_err(|e| e.to_string())?;
+        std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    }
+    let mut plan = FaultPlan::new();
+    for spec in &args.faults {
+        let (f, from, until) = parse_fault(spec, duration_us).map_err(|e| e.to_string())?;
+        plan.add(f, from, until).map_err(|e| e.to_string())?;
+    }
+    let mains = match args.mains {
+        50 => hand_model::emg::Mains::Hz50,
+        60 => hand_model::emg::Mains::Hz60,
+        m => return Err(format!("--mains {m}: must be 50 or 60")),
+    };
+    let amp = AmplifierNodeConfig {
+        signal: AmplifierConfig {
+            seed: args.seed,
+            mains,
+            ..AmplifierConfig::default()
+        },
+        ..AmplifierNodeConfig::default()
+    };
+    let nodes = NodeSelection {
+        amplifier: !args.no_amplifier,
+        fingers: parse_fingers(&args.fingers).map_err(|e| e.to_string())?,
+    };
+    match (&args.iface, args.mem) {
+        (Some(iface), false) => {
+            let iface = iface.clone();
+            let world = World::try_new(
+                amp,
+                FingerConfig::default(),
+                run.patient,
+                plan,
+                nodes,
+                0,
+                || SocketCanBus::open(&iface),
+            )
+            .map_err(|e| e.to_string())?;
+            eprintln!(
+                "handsim: scenario {} on {iface} for {:.1} s (real time)",
+                scenario.name(),
+                duration_us as f64 * 1e-6
+            );
+            run_realtime(world, duration_us);
+            Ok(())
+        }
+        (None, true) => {
+            let bus = MemBus::new().with_capacity(1 << 22);
+            let mut monitor = bus.endpoint();
+            let mut world = World::try_new(
+                amp,
+                FingerConfig::default(),
+                run.patient,
+                plan,
+                nodes,
+                0,
+                || Ok::<_, std::convert::Infallible>(bus.endpoint()),
+            )
+            .map_err(|e| e.to_string())?;
+            let mut per_id: BTreeMap<u32, u64> = BTreeMap::new();
+            let mut t = 0;
+            while t <= duration_us {
+                world.step(t);
+                while let Some(r) = monitor.receive_timestamped() {
+                    *per_id.entry(r.frame.raw_id()).or_default() += 1;
+                }
+                t += 1000;
+            }
+            let secs = duration_us as f64 * 1e-6;
+            println!(
+                "scenario {} for {secs:.3} s on the in-memory bus",
+                scenario.name()
+            );
+            println!("{:>6} {:>10} {:>10}", "id", "frames", "per s");
+            for (id, n) in &per_id {
+                println!("{id:#06x} {n:>10} {:>10.1}", *n as f64 / secs.max(1e-9));
+            }
+            println!(
+                "total {} frames; {} trials",
+                per_id.values().sum::<u64>(),
+                run.trials.len()
+            );
+            Ok(())
+        }
+        _ => Err("choose one transport: --iface IFACE (SocketCAN, real time) or --mem".into()),
+    }
+}
+
+fn run_realtime<B: Bus>(mut world: World<B>, duration_us: u64) {
+    let clock = SystemClock::new();
+    loop {
+        let now = clock.now_us();
+        if now > duration_us {
+            break;
+        }
+        world.step(now);
+        // 1 ms steps: the amplifier's frame period. Late wake-ups are caught up by the nodes.
+        std::thread::sleep(Duration::from_micros(1000 - now % 1000));
+    }
+    let amp = world.amplifier().stats();
+    eprintln!(
+        "handsim: done; {} frames sent, amplifier tx refused {} (queue full) / {} (errors), \
+{} samples skipped by stalls",
+        world.frames_sent(),
+        amp.tx_would_block,
+        amp.tx_errors,
+        world.amplifier().samples_dropped()
+    );
+}
+
+fn main() -> ExitCode {
+    match run() {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("handsim: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
