@@ -4,13 +4,20 @@
 //! - `chain/batch_1s_12ch`: the offline path over one second (1000 samples) of 12-channel
 //!   signal, including the chain's construction.
 //!
+//!
+//! Each is measured twice: wall time (criterion's default) and the benchmark thread's CPU time
+//! (`*_cpu`, via `cpu-time`), because the 2-core development machine is shared and wall time
+//! there includes time the thread spent preempted.
+//!
 //! Run: `cargo bench -p decoder --bench chain -- --warm-up-time 1 --measurement-time 3`
 
 // criterion_group! generates an undocumented `pub fn`.
 #![allow(missing_docs)]
 
+use cpu_time::ThreadTime;
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use decoder::dsp::{batch_features, Chain, ChainConfig};
+use std::time::Duration;
 
 /// Deterministic EMG-like noise (xorshift), `n` samples of `channels` channels, row-major.
 fn signal(n: usize, channels: usize) -> Vec<f64> {
@@ -23,6 +30,15 @@ fn signal(n: usize, channels: usize) -> Vec<f64> {
             ((s >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 400.0
         })
         .collect()
+}
+
+/// CPU time of this thread for `iters` calls of `f`.
+fn cpu_time_of<R>(iters: u64, mut f: impl FnMut() -> R) -> Duration {
+    let start = ThreadTime::now();
+    for _ in 0..iters {
+        black_box(f());
+    }
+    start.elapsed()
 }
 
 fn bench_chain(c: &mut Criterion) {
@@ -39,23 +55,32 @@ fn bench_chain(c: &mut Criterion) {
     }
     let ticks: Vec<&[f64]> = data.chunks_exact(step * ch).collect();
     let mut i = 0;
-    group.bench_function("tick_12ch_50_samples", |b| {
-        b.iter(|| {
-            let tick = ticks[i % ticks.len()];
-            i += 1;
-            let mut ready = false;
-            for s in tick.chunks_exact(ch) {
-                ready |= chain.push(black_box(s));
-            }
-            assert!(ready);
-            black_box(chain.features()[0])
-        })
+    let mut tick = move || {
+        let t = ticks[i % ticks.len()];
+        i += 1;
+        let mut ready = false;
+        for s in t.chunks_exact(ch) {
+            ready |= chain.push(black_box(s));
+        }
+        assert!(ready);
+        black_box(chain.features()[0])
+    };
+    group.bench_function("tick_12ch_50_samples", |b| b.iter(&mut tick));
+    group.bench_function("tick_12ch_50_samples_cpu", |b| {
+        b.iter_custom(|iters| cpu_time_of(iters, &mut tick))
     });
 
     let one_second = &data[..1000 * ch];
     group.throughput(Throughput::Elements(1000));
     group.bench_function("batch_1s_12ch", |b| {
         b.iter(|| black_box(batch_features(&settings, black_box(one_second))))
+    });
+    group.bench_function("batch_1s_12ch_cpu", |b| {
+        b.iter_custom(|iters| {
+            cpu_time_of(iters, || {
+                black_box(batch_features(&settings, black_box(one_second)));
+            })
+        })
     });
     group.finish();
 }

@@ -2,7 +2,7 @@
 
 use super::config::{ChainSettings, FeatureSignal};
 use super::faults::{Faults, MAX_ABS_SAMPLE};
-use super::features::{features_of_split, FEATURES_PER_CHANNEL};
+use super::features::{features_into, FEATURES_PER_CHANNEL};
 
 /// The streaming signal chain for all channels (see the module docs for the stages).
 ///
@@ -10,25 +10,34 @@ use super::features::{features_of_split, FEATURES_PER_CHANNEL};
 /// sample at a time with [`Chain::push`]. Every `step_len` samples, once the first window is
 /// full, a new feature vector is ready in [`Chain::features`]. Nothing here allocates, returns a
 /// `Result` or panics after construction.
+///
+/// Layout: filter state is section-major (`[section][channel]`), so each section runs over all
+/// channels in one loop the compiler vectorises; every channel still sees exactly the
+/// operations, in the order, of scipy's `sosfilt`.
 #[derive(Debug, Clone)]
 pub struct Chain {
     settings: ChainSettings,
     n_channels: usize,
-    n_sections: usize,
     window_len: usize,
     step_len: usize,
     rectify: bool,
-    /// Delay registers, `n_channels * n_sections`, channel-major.
-    state: Vec<[f64; 2]>,
-    /// Last `window_len` processed values per channel, channel-major; `head` is the slot the
-    /// next sample goes to, which is also the oldest sample once the ring is full.
+    /// First and second delay register of every section, `[section][channel]`.
+    z0: Vec<f64>,
+    z1: Vec<f64>,
+    /// Per channel `2 * window_len` slots, every value written twice (at `head` and
+    /// `head + window_len`) so the window `[head, head + window_len)` is always contiguous.
     ring: Vec<f64>,
+    /// Slot of the oldest sample of the window (= where the next sample goes).
     head: usize,
     /// Samples pushed since the last reset.
     count: u64,
     /// Feature vectors produced since the last reset.
     emitted: u64,
+    /// Samples still to push before the next feature vector.
+    until_features: usize,
     features: Vec<f64>,
+    /// The current sample of every channel on its way through the cascade; after it, the
+    /// filtered output.
     last_filtered: Vec<f64>,
     faults: Faults,
 }
@@ -37,20 +46,21 @@ impl Chain {
     /// A chain in reset state for `settings` (which it shares, not copies).
     pub fn new(settings: &ChainSettings) -> Chain {
         let n_channels = settings.n_channels();
-        let n_sections = settings.cascade().len();
+        let n_state = n_channels * settings.cascade().len();
         let window_len = settings.window_len();
         Chain {
             settings: settings.clone(),
             n_channels,
-            n_sections,
             window_len,
             step_len: settings.step_len(),
             rectify: settings.config().feature_signal == FeatureSignal::Rectified,
-            state: vec![[0.0; 2]; n_channels * n_sections],
-            ring: vec![0.0; n_channels * window_len],
+            z0: vec![0.0; n_state],
+            z1: vec![0.0; n_state],
+            ring: vec![0.0; n_channels * 2 * window_len],
             head: 0,
             count: 0,
             emitted: 0,
+            until_features: window_len,
             features: vec![0.0; settings.n_features()],
             last_filtered: vec![0.0; n_channels],
             faults: Faults::new(n_channels, window_len),
@@ -60,14 +70,25 @@ impl Chain {
     /// Back to the state right after [`Chain::new`]: filter state, window, features and fault
     /// counts cleared. Needed between recordings joined end to end.
     pub fn reset(&mut self) {
-        self.state.fill([0.0; 2]);
+        self.z0.fill(0.0);
+        self.z1.fill(0.0);
         self.ring.fill(0.0);
         self.head = 0;
         self.count = 0;
         self.emitted = 0;
+        self.until_features = self.window_len;
         self.features.fill(0.0);
         self.last_filtered.fill(0.0);
         self.faults.clear();
+    }
+
+    /// Zeroes the filter state of one channel (after a bad sample).
+    fn reset_channel_state(&mut self, ch: usize) {
+        let n = self.n_channels;
+        for s in 0..self.settings.cascade().len() {
+            self.z0[s * n + ch] = 0.0;
+            self.z1[s * n + ch] = 0.0;
+        }
     }
 
     /// Feeds one multi-channel sample (one value per channel, in channel order). Returns true
@@ -77,40 +98,57 @@ impl Chain {
     /// channel's filter state and is filtered as 0. A slice of the wrong length is counted too;
     /// missing channels are treated as non-finite, extra values are ignored.
     pub fn push(&mut self, sample: &[f64]) -> bool {
-        if sample.len() != self.n_channels {
+        let n = self.n_channels;
+        self.count += 1;
+        self.faults.set_now(self.count);
+        if sample.len() != n {
             self.faults.record_wrong_length();
         }
-        self.faults.tick();
-        let cascade = self.settings.cascade();
-        let w = self.window_len;
-        for ch in 0..self.n_channels {
-            let state = &mut self.state[ch * self.n_sections..(ch + 1) * self.n_sections];
+        for ch in 0..n {
             let raw = sample.get(ch).copied().unwrap_or(f64::NAN);
-            let x = if !raw.is_finite() {
-                self.faults.record_non_finite(ch);
-                state.fill([0.0; 2]);
-                0.0
-            } else if raw.abs() > MAX_ABS_SAMPLE {
-                self.faults.record_out_of_range(ch);
-                state.fill([0.0; 2]);
-                0.0
-            } else {
+            self.last_filtered[ch] = if raw.abs() <= MAX_ABS_SAMPLE {
                 raw
+            } else {
+                // NaN fails the comparison above and lands here too.
+                if raw.is_finite() {
+                    self.faults.record_out_of_range(ch);
+                } else {
+                    self.faults.record_non_finite(ch);
+                }
+                self.reset_channel_state(ch);
+                0.0
             };
-            let mut y = x;
-            for (section, z) in cascade.iter().zip(state.iter_mut()) {
-                y = section.step(z, y);
+        }
+
+        let work = &mut self.last_filtered[..n];
+        for (s, section) in self.settings.cascade().iter().enumerate() {
+            let [b0, b1, b2] = section.b;
+            let [_, a1, a2] = section.a;
+            let z0 = &mut self.z0[s * n..(s + 1) * n];
+            let z1 = &mut self.z1[s * n..(s + 1) * n];
+            for ((x, z0), z1) in work.iter_mut().zip(z0).zip(z1) {
+                // scipy sosfilt's transposed direct form II, term for term.
+                let xin = *x;
+                let y = b0 * xin + *z0;
+                *z0 = b1 * xin - a1 * y + *z1;
+                *z1 = b2 * xin - a2 * y;
+                *x = y;
             }
-            self.last_filtered[ch] = y;
-            self.ring[ch * w + self.head] = if self.rectify { y.abs() } else { y };
         }
-        self.head += 1;
-        if self.head == w {
-            self.head = 0;
+
+        let w = self.window_len;
+        let head = self.head;
+        for (ch, &y) in work.iter().enumerate() {
+            let v = if self.rectify { y.abs() } else { y };
+            let base = ch * 2 * w;
+            self.ring[base + head] = v;
+            self.ring[base + head + w] = v;
         }
-        self.count += 1;
-        let w64 = w as u64;
-        if self.count >= w64 && (self.count - w64).is_multiple_of(self.step_len as u64) {
+        self.head = if head + 1 == w { 0 } else { head + 1 };
+
+        self.until_features -= 1;
+        if self.until_features == 0 {
+            self.until_features = self.step_len;
             self.compute_features();
             self.emitted += 1;
             true
@@ -122,11 +160,11 @@ impl Chain {
     fn compute_features(&mut self) {
         let w = self.window_len;
         for ch in 0..self.n_channels {
-            let ring = &self.ring[ch * w..(ch + 1) * w];
-            let (newer, older) = ring.split_at(self.head);
+            let start = ch * 2 * w + self.head;
+            let window = &self.ring[start..start + w];
             let out =
                 &mut self.features[ch * FEATURES_PER_CHANNEL..(ch + 1) * FEATURES_PER_CHANNEL];
-            features_of_split(older, newer, out);
+            features_into(window, out);
         }
     }
 

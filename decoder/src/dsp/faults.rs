@@ -14,8 +14,10 @@ pub const MAX_ABS_SAMPLE: f64 = 1e12;
 pub struct Faults {
     non_finite: Vec<u64>,
     out_of_range: Vec<u64>,
-    /// Samples pushed since the channel's last bad sample (saturating; MAX = never).
-    since_bad: Vec<usize>,
+    /// Sample number (1-based, since reset) of the channel's last bad sample; 0 = none.
+    last_bad: Vec<u64>,
+    /// Number of the sample being pushed.
+    now: u64,
     window_len: usize,
     wrong_length: u64,
 }
@@ -25,7 +27,8 @@ impl Faults {
         Faults {
             non_finite: vec![0; n_channels],
             out_of_range: vec![0; n_channels],
-            since_bad: vec![usize::MAX; n_channels],
+            last_bad: vec![0; n_channels],
+            now: 0,
             window_len,
             wrong_length: 0,
         }
@@ -34,28 +37,32 @@ impl Faults {
     pub(crate) fn clear(&mut self) {
         self.non_finite.fill(0);
         self.out_of_range.fill(0);
-        self.since_bad.fill(usize::MAX);
+        self.last_bad.fill(0);
+        self.now = 0;
         self.wrong_length = 0;
     }
 
-    /// Ages every channel by one sample. Called once per pushed sample, before recording.
+    /// Sets the number (1-based) of the sample being pushed, before anything is recorded.
     #[inline]
-    pub(crate) fn tick(&mut self) {
-        for s in &mut self.since_bad {
-            *s = s.saturating_add(1);
-        }
+    pub(crate) fn set_now(&mut self, now: u64) {
+        self.now = now;
+    }
+
+    /// Whether a bad sample numbered `at` is among the last `window_len` samples.
+    fn is_recent(&self, at: u64) -> bool {
+        at != 0 && self.now - at < self.window_len as u64
     }
 
     #[inline]
     pub(crate) fn record_non_finite(&mut self, ch: usize) {
         self.non_finite[ch] += 1;
-        self.since_bad[ch] = 0;
+        self.last_bad[ch] = self.now;
     }
 
     #[inline]
     pub(crate) fn record_out_of_range(&mut self, ch: usize) {
         self.out_of_range[ch] += 1;
-        self.since_bad[ch] = 0;
+        self.last_bad[ch] = self.now;
     }
 
     #[inline]
@@ -104,11 +111,11 @@ impl Faults {
     /// Whether the current window of channel `ch` still holds a bad sample (its features are
     /// finite but describe a patched signal).
     pub fn in_window(&self, ch: usize) -> bool {
-        self.since_bad.get(ch).is_some_and(|&s| s < self.window_len)
+        self.last_bad.get(ch).is_some_and(|&at| self.is_recent(at))
     }
 
     /// Whether any channel's current window holds a bad sample.
     pub fn any_in_window(&self) -> bool {
-        self.since_bad.iter().any(|&s| s < self.window_len)
+        self.last_bad.iter().any(|&at| self.is_recent(at))
     }
 }

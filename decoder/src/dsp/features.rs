@@ -12,43 +12,78 @@ pub const FEATURE_NAMES: [&str; FEATURES_PER_CHANNEL] =
 /// A window shorter than 2 samples has no defined VAR/DASDV/DAMV: all features are 0 then.
 pub fn window_features(x: &[f64]) -> [f64; FEATURES_PER_CHANNEL] {
     let mut out = [0.0; FEATURES_PER_CHANNEL];
-    features_of_split(x, &[], &mut out);
+    features_into(x, &mut out);
     out
 }
 
-/// Features of the window `older ++ newer` (a ring buffer read in chronological order without
-/// copying). `out` has 8 slots. Allocation-free.
-pub(crate) fn features_of_split(older: &[f64], newer: &[f64], out: &mut [f64]) {
-    let n = older.len() + newer.len();
+/// Lanes of partial sums: two independent accumulators break the add latency chain and let
+/// the compiler vectorise; the order of additions is fixed, so results are deterministic.
+const LANES: usize = 2;
+
+fn lane_sum(acc: [f64; LANES]) -> f64 {
+    acc[0] + acc[1]
+}
+
+/// Features of the window `x` into `out[..8]`. Allocation-free.
+pub(crate) fn features_into(x: &[f64], out: &mut [f64]) {
+    let n = x.len();
     if n < 2 {
         out[..FEATURES_PER_CHANNEL].fill(0.0);
         return;
     }
     let nf = n as f64;
-    let mut sum = 0.0;
-    let mut sum_abs = 0.0;
-    let mut sum_sq = 0.0;
-    let mut wl = 0.0;
-    let mut d_sq = 0.0;
-    let mut prev = if older.is_empty() { newer[0] } else { older[0] };
-    for &v in older.iter().chain(newer) {
-        sum += v;
-        sum_abs += v.abs();
-        sum_sq += v * v;
-        let d = v - prev;
-        wl += d.abs();
-        d_sq += d * d;
-        prev = v;
+
+    // One pass over the pairs (x[i], x[i+1]), i < n - 1: the sums of x[i] and of the
+    // differences together; x[n-1] is added at the end.
+    let (mut sum, mut sum_abs, mut sum_sq) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
+    let (mut wl, mut d_sq) = ([0.0; LANES], [0.0; LANES]);
+    let (prev, next) = (&x[..n - 1], &x[1..]);
+    let pc = prev.chunks_exact(LANES);
+    let nc = next.chunks_exact(LANES);
+    let (prest, nrest) = (pc.remainder(), nc.remainder());
+    for (p, q) in pc.zip(nc) {
+        for l in 0..LANES {
+            let v = p[l];
+            sum[l] += v;
+            sum_abs[l] += v.abs();
+            sum_sq[l] += v * v;
+            let d = q[l] - v;
+            wl[l] += d.abs();
+            d_sq[l] += d * d;
+        }
     }
+    for (l, (&v, &q)) in prest.iter().zip(nrest).enumerate() {
+        sum[l] += v;
+        sum_abs[l] += v.abs();
+        sum_sq[l] += v * v;
+        let d = q - v;
+        wl[l] += d.abs();
+        d_sq[l] += d * d;
+    }
+    let last = x[n - 1];
+    let sum = lane_sum(sum) + last;
+    let sum_abs = lane_sum(sum_abs) + last.abs();
+    let sum_sq = lane_sum(sum_sq) + last * last;
+    let (wl, d_sq) = (lane_sum(wl), lane_sum(d_sq));
+
     // Two-pass variance: the rectified signal has a large mean next to its spread, and the
     // one-pass form would cancel catastrophically.
     let mean = sum / nf;
-    let mut ss = 0.0;
-    for &v in older.iter().chain(newer) {
-        let c = v - mean;
-        ss += c * c;
+    let mut ss = [0.0; LANES];
+    let chunks = x.chunks_exact(LANES);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for l in 0..LANES {
+            let d = c[l] - mean;
+            ss[l] += d * d;
+        }
     }
-    let var = ss / (nf - 1.0);
+    for (l, &v) in rest.iter().enumerate() {
+        let d = v - mean;
+        ss[l] += d * d;
+    }
+    let var = lane_sum(ss) / (nf - 1.0);
+
     out[0] = (sum_sq / nf).sqrt();
     out[1] = sum_abs / nf;
     out[2] = var;
@@ -79,11 +114,33 @@ mod tests {
     }
 
     #[test]
-    fn split_equals_contiguous() {
-        let x = [0.5, 1.5, -0.25, 4.0, 2.0, -1.0];
-        let whole = window_features(&x);
-        let mut split = [0.0; 8];
-        features_of_split(&x[..2], &x[2..], &mut split);
-        assert_eq!(whole, split);
+    fn lengths_not_multiple_of_lanes() {
+        // A plain single-accumulator reference for every length around the lane width.
+        for n in 2..11 {
+            let x: Vec<f64> = (0..n).map(|i| ((i * 37) % 11) as f64 - 4.5).collect();
+            let f = window_features(&x);
+            let nf = n as f64;
+            let mean = x.iter().sum::<f64>() / nf;
+            let var = x.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (nf - 1.0);
+            let wl: f64 = x.windows(2).map(|p| (p[1] - p[0]).abs()).sum();
+            let dsq: f64 = x.windows(2).map(|p| (p[1] - p[0]).powi(2)).sum();
+            let want = [
+                (x.iter().map(|v| v * v).sum::<f64>() / nf).sqrt(),
+                x.iter().map(|v| v.abs()).sum::<f64>() / nf,
+                var,
+                var.sqrt(),
+                x.iter().map(|v| v.abs()).sum::<f64>(),
+                wl,
+                (dsq / (nf - 1.0)).sqrt(),
+                wl / (nf - 1.0),
+            ];
+            for (a, b) in f.iter().zip(want) {
+                assert!(
+                    (a - b).abs() <= 1e-12 * b.abs().max(1.0),
+                    "n {n}: {a} vs {b}"
+                );
+            }
+        }
+        assert_eq!(window_features(&[3.0]), [0.0; 8]);
     }
 }
