@@ -5,7 +5,7 @@ use hand_dbc::e2e::E2eProfile;
 pub use hand_dbc::CanFrame;
 
 /// ADC resolution of the EMG signals: µV per count (hand.dbc EMG_SAMPLES factor).
-pub const EMG_LSB_UV: f64 = hand_dbc::messages::EmgSamplesG0::EMG0_FACTOR;
+pub const EMG_LSB_UV: f64 = hand_dbc::emg::EMG_LSB_UV;
 
 /// Writes `counter` into the alive-counter bits of byte 1 and the CRC into byte 0.
 ///

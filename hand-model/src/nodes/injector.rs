@@ -9,10 +9,10 @@ use crate::faults::{Fault, FaultPlan};
 /// Id of the flood: above every hand.dbc id in priority, so it wins arbitration.
 pub const FLOOD_ID: u16 = 0x001;
 /// Worst-case bits of an 8-byte classic frame with 11-bit id (hand.dbc's bus-load formula:
-/// 47 + 8·DLC + ⌊(34 + 8·DLC − 1)/4⌋).
-pub const FLOOD_FRAME_BITS: u64 = 135;
+/// 47 + 8·DLC + ⌊(34 + 8·DLC − 1)/4⌋ = 135).
+pub const FLOOD_FRAME_BITS: u64 = hand_dbc::busload::frame_bits_worst_case(8);
 /// Bit rate of the bus.
-pub const BUS_BIT_RATE: u64 = 1_000_000;
+pub const BUS_BIT_RATE: u64 = hand_dbc::busload::BITRATE_BPS as u64;
 /// HAND_ESTOP repetition while asserted, µs (hand.dbc GenMsgCycleTime).
 pub const ESTOP_PERIOD_US: u64 = 10_000;
 
