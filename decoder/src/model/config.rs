@@ -102,6 +102,14 @@ pub enum ValidationSplit {
         /// Fraction of trials held out, in (0, 1).
         fraction: f64,
     },
+    /// Hold out the last `fraction` of every trial's windows (in the order they were pushed,
+    /// which must be time order), dropping the windows between the two parts that share samples
+    /// with both (`ceil(window / step) - 1` of them, from the dataset's chain configuration).
+    /// Not leaky, and works when each label has a single trial (a one-repetition calibration).
+    TrialTail {
+        /// Fraction of each trial's windows held out, in (0, 1).
+        fraction: f64,
+    },
     /// Hold out random windows. **Leaky**: windows overlap 75%, so held-out windows are near
     /// copies of training windows and early stopping stops late. Offered only to reproduce the
     /// paper's protocol.
@@ -176,7 +184,9 @@ impl TrainConfig {
             ));
         }
         match self.split {
-            ValidationSplit::Trial { fraction } | ValidationSplit::Window { fraction }
+            ValidationSplit::Trial { fraction }
+            | ValidationSplit::TrialTail { fraction }
+            | ValidationSplit::Window { fraction }
                 if !(fraction > 0.0 && fraction < 1.0) =>
             {
                 bad(format!(

@@ -39,7 +39,8 @@ impl Dataset {
         })
     }
 
-    /// Adds one window. `target[f]` is the label of finger `f` (+1 maximal flexion, -1 maximal
+    /// Adds one window; a trial's windows must be added in time order (the trial-tail split
+    /// relies on it). `target[f]` is the label of finger `f` (+1 maximal flexion, -1 maximal
     /// extension, 0 rest); `mask[f]` is true when that label enters the loss. Errors on a wrong
     /// feature count, a non-finite feature, or a non-finite unmasked target.
     pub fn push(

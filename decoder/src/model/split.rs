@@ -45,6 +45,30 @@ pub(crate) fn make_split(
             train.sort_unstable();
             Ok(Split { train, val })
         }
+        ValidationSplit::TrialTail { fraction } => {
+            let chain = d.chain();
+            // Windows whose samples overlap a given window: ceil(window / step) - 1.
+            let gap = ((chain.window_ms / chain.step_ms).ceil() as usize).saturating_sub(1);
+            let mut by_trial: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+            for i in 0..n {
+                by_trial.entry(d.trial(i)).or_default().push(i);
+            }
+            let (mut train, mut val) = (Vec::new(), Vec::new());
+            for (t, idx) in &by_trial {
+                let m = idx.len();
+                let n_val = (fraction * m as f64).round() as usize;
+                if n_val == 0 || n_val + gap >= m {
+                    return Err(TrainError::Split(format!(
+                        "trial {t} has {m} windows: too few to hold out {fraction} of them plus                          {gap} overlapping windows"
+                    )));
+                }
+                train.extend_from_slice(&idx[..m - n_val - gap]);
+                val.extend_from_slice(&idx[m - n_val..]);
+            }
+            train.sort_unstable();
+            val.sort_unstable();
+            Ok(Split { train, val })
+        }
         ValidationSplit::Trial { fraction } => {
             // Trial -> label of its first window; label -> number of trials still in training.
             let mut trial_label: BTreeMap<usize, [u64; N_FINGERS]> = BTreeMap::new();
@@ -77,8 +101,8 @@ pub(crate) fn make_split(
             if held.is_empty() {
                 return Err(TrainError::Split(format!(
                     "no trial can be held out without losing a label ({n_trials} trials, every \
-                     finger/direction has a single trial): record repetitions, or choose the \
-                     window split (leaky) or no split"
+                     finger/direction has a single trial): record repetitions, or hold out the \
+                     end of each trial (trial-tail split)"
                 )));
             }
             held.sort_unstable();

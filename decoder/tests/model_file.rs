@@ -1,0 +1,241 @@
+//! Model files: round trip, atomic save, and every refusal on load.
+
+mod model_support;
+
+use std::path::PathBuf;
+
+use decoder::dsp::ChainConfig;
+use decoder::model::{
+    train, FileError, ModelKind, ModelSpec, TrainConfig, TrainedModel, HEADER_LEN, MAGIC,
+};
+use model_support::{calibration, chain};
+
+fn trained(kind: ModelKind) -> TrainedModel {
+    let mut spec = ModelSpec::default();
+    spec.resdd.hidden = 8;
+    spec.ln.hidden = [8, 8];
+    spec.mlp.hidden = [8, 8];
+    spec.cnn.filters = [3, 3];
+    spec.cnn.dense = 8;
+    let cfg = TrainConfig {
+        max_epochs: 3,
+        ..TrainConfig::default()
+    };
+    train(kind, &spec, &calibration(2, 2, 4, 11), &cfg, &mut |_| {}).expect("trains")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!(
+        "handstack-model-test-{}-{name}",
+        std::process::id()
+    ));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("temp dir");
+    d
+}
+
+/// The body split into metadata JSON and raw values, and a way to put it back together
+/// with a correct header (so only the intended defect is left in the file).
+struct Parts {
+    meta: serde_json::Value,
+    data: Vec<u8>,
+}
+
+fn split(bytes: &[u8]) -> Parts {
+    let body = &bytes[HEADER_LEN..];
+    let meta_len = u64::from_le_bytes(body[..8].try_into().unwrap()) as usize;
+    Parts {
+        meta: serde_json::from_slice(&body[8..8 + meta_len]).expect("metadata is JSON"),
+        data: body[8 + meta_len..].to_vec(),
+    }
+}
+
+fn join(p: &Parts) -> Vec<u8> {
+    let meta = serde_json::to_vec(&p.meta).unwrap();
+    let mut body = (meta.len() as u64).to_le_bytes().to_vec();
+    body.extend_from_slice(&meta);
+    body.extend_from_slice(&p.data);
+    let mut out = MAGIC.to_vec();
+    out.extend_from_slice(&1u32.to_le_bytes());
+    out.extend_from_slice(&crc32fast::hash(&body).to_le_bytes());
+    out.extend_from_slice(&(body.len() as u64).to_le_bytes());
+    out.extend_from_slice(&body);
+    out
+}
+
+#[test]
+fn save_load_round_trip_is_bit_exact_for_every_kind() {
+    let dir = temp_dir("roundtrip");
+    for kind in ModelKind::ALL {
+        let m = trained(kind);
+        let path = dir.join(format!("{kind}.hsm"));
+        m.save(&path).expect("saves");
+        // Saving again replaces the file in one step.
+        m.save(&path).expect("saves over an existing file");
+        let back = TrainedModel::load(&path, Some(&chain(2))).expect("loads");
+        assert_eq!(back, m, "{kind}");
+        let x: Vec<f64> = (0..16).map(|i| 10.0 * i as f64).collect();
+        let (a, b) = (m.predict(&x), back.predict(&x));
+        assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits));
+        assert_eq!(back.sample_rate_hz(), 1000.0);
+        assert_eq!(back.n_channels(), 2);
+        // Also loads without a chain to compare against (e.g. for `handctl info`).
+        assert!(TrainedModel::load(&path, None).is_ok());
+    }
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".tmp"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn file_is_self_describing() {
+    let bytes = trained(ModelKind::ResDd).to_bytes().unwrap();
+    let p = split(&bytes);
+    let m = &p.meta;
+    assert_eq!(m["format"], "handstack-model");
+    assert_eq!(m["kind"], "resdd");
+    assert_eq!(m["n_inputs"], 16);
+    assert_eq!(m["n_outputs"], 5);
+    assert_eq!(m["n_channels"], 2);
+    assert_eq!(m["sample_rate_hz"], 1000.0);
+    assert_eq!(m["feature_names"][9], "ch1.MAV");
+    assert_eq!(m["tensors"][0]["name"], "w_in");
+    assert_eq!(m["tensors"][0]["shape"], serde_json::json!([8, 16]));
+    assert_eq!(m["normalizer"]["shape"], serde_json::json!([16]));
+    assert_eq!(m["summary"]["epochs_run"], 3);
+    assert_eq!(m["chain"]["channels"], 2);
+    // w_in + 2 modules + w_out, then 16 scales.
+    assert_eq!(p.data.len(), 8 * (8 * 16 + 2 * 64 + 5 * 8 + 16));
+}
+
+#[test]
+fn load_rejects_each_defect_with_a_named_error() {
+    let good = trained(ModelKind::ResDd).to_bytes().unwrap();
+    let load = |b: &[u8]| TrainedModel::from_bytes(b, Some(&chain(2))).unwrap_err();
+    assert!(
+        TrainedModel::from_bytes(&join(&split(&good)), Some(&chain(2))).is_ok(),
+        "helper round trip"
+    );
+
+    assert!(matches!(
+        load(b"not a model at all, just text"),
+        FileError::NotAModelFile
+    ));
+
+    let mut v = good.clone();
+    v[8..12].copy_from_slice(&7u32.to_le_bytes());
+    assert!(matches!(
+        load(&v),
+        FileError::UnknownVersion {
+            found: 7,
+            supported: 1
+        }
+    ));
+
+    let e = load(&good[..good.len() - 1]);
+    assert!(matches!(e, FileError::Length { .. }), "{e}");
+
+    let mut v = good.clone();
+    let last = v.len() - 20;
+    v[last] ^= 0x40;
+    let e = load(&v);
+    assert!(matches!(e, FileError::BadChecksum { .. }), "{e}");
+    assert!(e.to_string().contains("checksum"));
+
+    // A tensor of the wrong shape (checksum recomputed, so only the shape is wrong).
+    let mut p = split(&good);
+    p.meta["tensors"][1]["shape"] = serde_json::json!([8, 9]);
+    match load(&join(&p)) {
+        FileError::WrongShape {
+            tensor,
+            expected,
+            found,
+        } => {
+            assert_eq!(
+                (tensor.as_str(), expected, found),
+                ("w_mod.1", vec![8, 8], vec![8, 9])
+            );
+        }
+        e => panic!("expected WrongShape, got {e}"),
+    }
+    // The spec says more modules than the file has tensors for.
+    let mut p = split(&good);
+    p.meta["spec"]["resdd"]["modules"] = serde_json::json!(3);
+    let e = load(&join(&p));
+    assert!(
+        matches!(e, FileError::WrongShape { ref tensor, .. } if tensor == "w_mod.3"),
+        "{e}"
+    );
+    // Normalizer of the wrong length.
+    let mut p = split(&good);
+    p.meta["normalizer"]["shape"] = serde_json::json!([15]);
+    let e = load(&join(&p));
+    assert!(
+        matches!(e, FileError::WrongShape { ref tensor, .. } if tensor == "normalizer.scale"),
+        "{e}"
+    );
+    // Input size that does not match the chain's channel count.
+    let mut p = split(&good);
+    p.meta["n_inputs"] = serde_json::json!(96);
+    assert!(matches!(load(&join(&p)), FileError::WrongShape { .. }));
+
+    // Non-finite weights: NaN in w_mod.1, infinity in the normalizer.
+    let mut p = split(&good);
+    let at = 8 * (8 * 16 + 5);
+    p.data[at..at + 8].copy_from_slice(&f64::NAN.to_le_bytes());
+    match load(&join(&p)) {
+        FileError::NonFiniteWeight { tensor, index } => {
+            assert_eq!((tensor.as_str(), index), ("w_mod.1", 5))
+        }
+        e => panic!("expected NonFiniteWeight, got {e}"),
+    }
+    let mut p = split(&good);
+    let n = p.data.len();
+    p.data[n - 8..].copy_from_slice(&f64::INFINITY.to_le_bytes());
+    let e = load(&join(&p));
+    assert!(
+        matches!(e, FileError::NonFiniteWeight { ref tensor, index: 15 } if tensor == "normalizer.scale"),
+        "{e}"
+    );
+
+    // Weight data of the wrong length.
+    let mut p = split(&good);
+    p.data.truncate(p.data.len() - 8);
+    assert!(matches!(load(&join(&p)), FileError::Malformed(_)));
+    // Metadata that is not JSON.
+    let mut v = MAGIC.to_vec();
+    let body = [&4u64.to_le_bytes()[..], b"{{{{"].concat();
+    v.extend_from_slice(&1u32.to_le_bytes());
+    v.extend_from_slice(&crc32fast::hash(&body).to_le_bytes());
+    v.extend_from_slice(&(body.len() as u64).to_le_bytes());
+    v.extend_from_slice(&body);
+    assert!(matches!(load(&v), FileError::Malformed(_)));
+
+    // A model trained on another chain configuration.
+    let running = ChainConfig {
+        mains_hz: 60,
+        window_ms: 100.0,
+        ..chain(2)
+    };
+    match TrainedModel::from_bytes(&good, Some(&running)).unwrap_err() {
+        FileError::ChainMismatch { fields } => assert_eq!(fields, ["mains_hz", "window_ms"]),
+        e => panic!("expected ChainMismatch, got {e}"),
+    }
+    let e = TrainedModel::from_bytes(&good, Some(&chain(12))).unwrap_err();
+    assert!(e.to_string().contains("channels"), "{e}");
+}
+
+#[test]
+fn io_errors_name_the_path() {
+    let e = TrainedModel::load("/nonexistent/dir/model.hsm", None).unwrap_err();
+    assert!(matches!(e, FileError::Io { op: "read", .. }));
+    assert!(e.to_string().contains("/nonexistent/dir/model.hsm"), "{e}");
+    let e = trained(ModelKind::Ln)
+        .save("/nonexistent/dir/model.hsm")
+        .unwrap_err();
+    assert!(matches!(e, FileError::Io { op: "create", .. }), "{e}");
+}

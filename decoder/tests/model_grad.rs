@@ -1,0 +1,142 @@
+//! Analytic gradients of every architecture against central finite differences.
+
+use decoder::model::{
+    AnyModel, CnnSpec, LnSpec, MlpSpec, Model, ModelKind, ModelSpec, ResDdSpec, ResDdVariant,
+    Trainable,
+};
+
+/// Small deterministic generator (SplitMix64) so the test needs no RNG crate.
+struct Gen(u64);
+impl Gen {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^= z >> 31;
+        (z >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    }
+}
+
+/// Loss `L = c · f(x)`; returns the worst relative error between analytic and numeric `∂L/∂θ`.
+fn check(mut m: AnyModel, seed: u64) -> f64 {
+    let mut g = Gen(seed);
+    let x: Vec<f64> = (0..m.n_inputs()).map(|_| g.next()).collect();
+    let c: Vec<f64> = (0..m.n_outputs()).map(|_| g.next()).collect();
+    let mut s = m.new_scratch();
+    let mut y = vec![0.0; m.n_outputs()];
+    m.predict_with(&x, &mut y, &mut s);
+    let mut grad = vec![0.0; m.params().len()];
+    m.backward(&x, &c, &mut s, &mut grad);
+    // The gradient accumulates: a second backward doubles it.
+    let mut twice = grad.clone();
+    m.backward(&x, &c, &mut s, &mut twice);
+    for (a, b) in grad.iter().zip(&twice) {
+        assert!(
+            (2.0 * a - b).abs() <= 1e-12 * (1.0 + b.abs()),
+            "backward must accumulate"
+        );
+    }
+    let loss = |m: &AnyModel, s: &mut decoder::model::Scratch| {
+        let mut y = vec![0.0; m.n_outputs()];
+        m.predict_with(&x, &mut y, s);
+        y.iter().zip(&c).map(|(a, b)| a * b).sum::<f64>()
+    };
+    let mut worst = 0.0f64;
+    let n = m.params().len();
+    // Every parameter for small models; a strided subset beyond 3000 keeps the test quick.
+    let stride = (n / 3000).max(1);
+    for i in (0..n).step_by(stride) {
+        let p0 = m.params()[i];
+        let h = 1e-6 * (1.0 + p0.abs());
+        m.params_mut()[i] = p0 + h;
+        let lp = loss(&m, &mut s);
+        m.params_mut()[i] = p0 - h;
+        let lm = loss(&m, &mut s);
+        m.params_mut()[i] = p0;
+        let num = (lp - lm) / (2.0 * h);
+        // Central differences carry ~1e-10 of round-off here: relative 1e-5 above that floor.
+        let diff = (num - grad[i]).abs();
+        worst = worst.max(diff / (1e-9 + num.abs().max(grad[i].abs())));
+        assert!(
+            diff <= 1e-8 + 1e-5 * num.abs().max(grad[i].abs()),
+            "param {i}: analytic {} numeric {num}",
+            grad[i]
+        );
+    }
+    worst
+}
+
+fn spec() -> ModelSpec {
+    ModelSpec {
+        resdd: ResDdSpec {
+            hidden: 7,
+            modules: 2,
+            variant: ResDdVariant::InputGated,
+        },
+        ln: LnSpec { hidden: [6, 5] },
+        mlp: MlpSpec { hidden: [9, 6] },
+        cnn: CnnSpec {
+            features_per_channel: 8,
+            filters: [4, 3],
+            kernel: 3,
+            dense: 6,
+        },
+    }
+}
+
+#[test]
+fn resdd_gradients_all_depths_and_variants() {
+    for variant in [ResDdVariant::InputGated, ResDdVariant::Chained] {
+        for modules in 0..=3 {
+            let mut sp = spec();
+            sp.resdd.modules = modules;
+            sp.resdd.variant = variant;
+            // Larger input gain than training's init, so the multiplicative terms matter.
+            let mut m = AnyModel::random(ModelKind::ResDd, &sp, 11, 5, 3).expect("model");
+            for p in m.params_mut() {
+                *p *= 2.0;
+            }
+            check(m, 100 + modules as u64);
+        }
+    }
+}
+
+#[test]
+fn ln_gradients() {
+    check(
+        AnyModel::random(ModelKind::Ln, &spec(), 13, 5, 4).expect("model"),
+        5,
+    );
+}
+
+#[test]
+fn mlp_gradients() {
+    for seed in 0..3 {
+        check(
+            AnyModel::random(ModelKind::Mlp, &spec(), 13, 5, seed).expect("model"),
+            10 + seed,
+        );
+    }
+}
+
+#[test]
+fn cnn_gradients_even_and_odd_electrode_counts() {
+    for (electrodes, kernel) in [(4, 3), (5, 3), (6, 5), (2, 1)] {
+        let mut sp = spec();
+        sp.cnn.kernel = kernel;
+        for seed in 0..2 {
+            let m = AnyModel::random(ModelKind::Cnn, &sp, 8 * electrodes, 5, seed).expect("model");
+            check(m, 20 + seed);
+        }
+    }
+}
+
+#[test]
+fn default_sized_models_gradients() {
+    // The shapes the daemon runs (96 features, 5 fingers), strided over parameters.
+    for kind in ModelKind::ALL {
+        let m = AnyModel::random(kind, &ModelSpec::default(), 96, 5, 1).expect("model");
+        check(m, 42);
+    }
+}
