@@ -1,6 +1,23 @@
 //! The simulated world on the bus: an sEMG amplifier node, finger motor-controller nodes and a
 //! simulated patient, so that the daemon can be calibrated, run and broken without a person or
-//! a prosthesis.
+//! a prosthesis. It speaks hand.dbc through `hand-dbc` and nothing else: it never depends on
+//! the daemon.
+//!
+//! Map:
+//! - [`clock`]: [`Clock`], [`VirtualClock`] (tests), [`SystemClock`] (real time).
+//! - [`bus`]: [`MemBus`], an in-memory broadcast CAN bus whose endpoints implement
+//!   `embedded_can::nb::Can` and `blocking::Can`; [`socketcan_bus`] is the SocketCAN transport.
+//! - [`emg`]: the signal model: 10 muscle sources (flexor and extensor per finger), cross-talk
+//!   into 12 channels, mains, DC offset and drift, noise floor, 12-bit ADC.
+//! - [`patient`]: intents per finger, scripts (rest, holds, ramps, gestures), the calibration
+//!   protocol with its [`patient::CalibrationTrial`] metadata, and the closed-loop user.
+//! - [`finger`]: one finger's mechanics and control law.
+//! - [`nodes`]: the bus nodes, each stepped by `poll(now_us, &mut bus)`: amplifier, motor
+//!   controllers, fault injector, and a setpoint source standing in for the daemon in tests.
+//! - [`faults`]: faults on demand ([`faults::Fault`], [`faults::FaultPlan`]).
+//! - [`world`] and [`scenario`]: all nodes and the patient together, and named scenarios.
+//!
+//! Fingers are indexed 0 thumb, 1 index, 2 middle, 3 ring, 4 pinky (the paper's L(5-f)).
 
 pub mod bus;
 pub mod clock;
@@ -18,3 +35,5 @@ pub mod world;
 pub use bus::{MemBus, MemBusError, MemEndpoint, Received};
 pub use clock::{Clock, SystemClock, VirtualClock};
 pub use error::SimError;
+pub use scenario::Scenario;
+pub use world::World;

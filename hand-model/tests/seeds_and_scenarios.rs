@@ -177,6 +177,7 @@ fn closed_loop_user_tracks_the_sine_through_a_force_controlled_finger() {
     }
     let nrmse = (err2 / target2).sqrt();
     // A human-like tracker (200 ms delay, noise) follows a 0.25 Hz sine well but not perfectly.
-    assert!(nrmse < 0.5, "normalised tracking error {nrmse}");
+    // Measured 0.08 with the default patient; 0.25 leaves room without hiding a broken loop.
+    assert!(nrmse < 0.25, "normalised tracking error {nrmse}");
     assert!(nrmse > 0.01, "suspiciously perfect tracking {nrmse}");
 }

@@ -191,8 +191,9 @@ impl AmplifierNode {
             }
         }
         self.sample_counter = counter.wrapping_add(1);
-        let frames = emg_frames(&sample, counter);
-        let Some(mut frames) = frames else {
+        let Some(mut frames) = emg_frames(&sample, counter) else {
+            // Unreachable while the quantiser clips to the DBC range; counted, never hidden.
+            self.stats.tx_errors += 3;
             return;
         };
         let silent = self
@@ -299,6 +300,7 @@ impl AmplifierNode {
         };
         let Ok(msg) = EmgStatus::new(state, rate, AmpGain::Gain1, lead_off, saturation, faults)
         else {
+            self.stats.tx_errors += 1;
             return;
         };
         let mut frame = msg.to_frame();

@@ -98,6 +98,7 @@ impl FaultInjector {
             EstopSource::Tool,
             EstopReason::Technician,
         ) else {
+            self.stats.tx_errors += 1;
             return;
         };
         let mut frame = msg.to_frame();

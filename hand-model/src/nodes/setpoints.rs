@@ -94,6 +94,8 @@ impl SetpointSource {
             let Ok(msg) =
                 FingerSetpoint::new(self.finger, self.mode, self.force_n, self.velocity_rad_s)
             else {
+                // Unreachable: `set` checked the values against the DBC.
+                self.stats.tx_errors += 1;
                 continue;
             };
             let mut frame = msg.to_frame();
