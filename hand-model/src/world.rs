@@ -30,7 +30,7 @@ pub struct World<B: Bus> {
     patient: PatientMode,
     patient_bus: B,
     patient_stats: NodeStats,
-    amp: (AmplifierNode, B),
+    amp: Option<(AmplifierNode, B)>,
     fingers: Vec<(FingerNode, B)>,
     injector: (FaultInjector, B),
     intent: Intent,
@@ -54,53 +54,60 @@ impl Default for NodeSelection {
     }
 }
 
+/// Everything about a world except the patient and the transport.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct WorldConfig {
+    /// The amplifier (its `start_us` is overridden by `start_us` below).
+    pub amplifier: AmplifierNodeConfig,
+    /// Every finger's limits and timing.
+    pub finger: FingerConfig,
+    /// Faults, handed to every node.
+    pub faults: FaultPlan,
+    /// Which nodes run.
+    pub nodes: NodeSelection,
+    /// Node time at which the scenario starts (scripts count from here), µs.
+    pub start_us: u64,
+}
+
 impl<B: Bus> World<B> {
-    /// Builds the world starting at `start_us`; `open` is called once per node for its bus
-    /// handle (patient, amplifier, injector, then each selected finger).
+    /// Builds the world; `open` is called once per node for its own bus handle (patient,
+    /// injector, amplifier if selected, then each selected finger in order).
     pub fn try_new<E: std::fmt::Display>(
-        mut amp_cfg: AmplifierNodeConfig,
-        finger_cfg: FingerConfig,
+        cfg: WorldConfig,
         patient: PatientMode,
-        faults: FaultPlan,
-        nodes: NodeSelection,
-        start_us: u64,
         mut open: impl FnMut() -> Result<B, E>,
     ) -> Result<Self, SimError> {
         let mut open = || open().map_err(|e| SimError::Transport(e.to_string()));
-        amp_cfg.start_us = start_us;
-        let mut amp = AmplifierNode::try_new(amp_cfg)?;
-        amp.set_faults(faults.clone());
-        if !nodes.amplifier {
-            amp.set_faults(FaultPlan::new());
-        }
         let patient_bus = open()?;
-        let amp_bus = open()?;
-        let injector_bus = open()?;
+        let injector = (FaultInjector::new(cfg.faults.clone()), open()?);
+        let amp = if cfg.nodes.amplifier {
+            let mut amp = AmplifierNode::try_new(AmplifierNodeConfig {
+                start_us: cfg.start_us,
+                ..cfg.amplifier
+            })?;
+            amp.set_faults(cfg.faults.clone());
+            Some((amp, open()?))
+        } else {
+            None
+        };
         let mut fingers = Vec::new();
         for f in 0..N_FINGERS {
-            if nodes.fingers & (1 << f) != 0 {
-                let mut node = FingerNode::try_new(f, finger_cfg, start_us)?;
-                node.set_faults(faults.clone());
+            if cfg.nodes.fingers & (1 << f) != 0 {
+                let mut node = FingerNode::try_new(f, cfg.finger, cfg.start_us)?;
+                node.set_faults(cfg.faults.clone());
                 fingers.push((node, open()?));
             }
         }
-        // An unselected amplifier is represented by a silent plan: the node still exists so
-        // the world's shape does not depend on the selection, but it is never polled.
-        let amp_enabled = nodes.amplifier;
-        let mut world = Self {
-            start_us,
+        Ok(Self {
+            start_us: cfg.start_us,
             patient,
             patient_bus,
             patient_stats: NodeStats::default(),
-            amp: (amp, amp_bus),
+            amp,
             fingers,
-            injector: (FaultInjector::new(faults), injector_bus),
+            injector,
             intent: Intent::REST,
-        };
-        if !amp_enabled {
-            world.amp.0.set_faults(silence_forever());
-        }
-        Ok(world)
+        })
     }
 
     /// Advances every node to `now_us`.
@@ -120,8 +127,10 @@ impl<B: Bus> World<B> {
             PatientMode::Script(s) => s.intent_at(rel),
             PatientMode::ClosedLoop(u) => u.intent_at(rel),
         };
-        self.amp.0.set_intent(self.intent);
-        self.amp.0.poll(now_us, &mut self.amp.1);
+        if let Some((amp, bus)) = &mut self.amp {
+            amp.set_intent(self.intent);
+            amp.poll(now_us, bus);
+        }
         for (node, bus) in &mut self.fingers {
             node.poll(now_us, bus);
         }
@@ -133,9 +142,9 @@ impl<B: Bus> World<B> {
         self.intent
     }
 
-    /// The amplifier node.
-    pub fn amplifier(&self) -> &AmplifierNode {
-        &self.amp.0
+    /// The amplifier node, if it runs.
+    pub fn amplifier(&self) -> Option<&AmplifierNode> {
+        self.amp.as_ref().map(|(a, _)| a)
     }
 
     /// The motor controllers that run.
@@ -150,7 +159,7 @@ impl<B: Bus> World<B> {
 
     /// Frames sent by all nodes so far.
     pub fn frames_sent(&self) -> u64 {
-        self.amp.0.stats().tx_frames
+        self.amp.as_ref().map_or(0, |(a, _)| a.stats().tx_frames)
             + self.injector.0.stats().tx_frames
             + self
                 .fingers
@@ -158,11 +167,4 @@ impl<B: Bus> World<B> {
                 .map(|(n, _)| n.stats().tx_frames)
                 .sum::<u64>()
     }
-}
-
-fn silence_forever() -> FaultPlan {
-    let mut p = FaultPlan::new();
-    // Cannot fail: a valid fault over a non-empty window.
-    let _ = p.add(crate::faults::Fault::AmplifierSilence, 0, u64::MAX);
-    p
 }

@@ -10,10 +10,9 @@ use hand_dbc::messages::{
 };
 use hand_model::bus::MemEndpoint;
 use hand_model::faults::{CrcTarget, Fault, FaultPlan};
-use hand_model::finger::FingerConfig;
-use hand_model::nodes::{AmplifierNodeConfig, SetpointSource};
+use hand_model::nodes::SetpointSource;
 use hand_model::patient::{Intent, Script};
-use hand_model::world::{NodeSelection, PatientMode, World};
+use hand_model::world::{PatientMode, World, WorldConfig};
 
 const FROM: u64 = 200_000;
 const UNTIL: u64 = 400_000;
@@ -28,15 +27,13 @@ fn run_with(fault: Fault) -> Harness {
     let bus = h.bus.clone();
     let mut script = Script::new();
     script.hold(Intent::all(0.5), END + 1);
-    let mut world: World<MemEndpoint> = World::try_new(
-        AmplifierNodeConfig::default(),
-        FingerConfig::default(),
-        PatientMode::Script(script),
-        plan,
-        NodeSelection::default(),
-        0,
-        || Ok::<_, std::convert::Infallible>(bus.endpoint()),
-    )
+    let cfg = WorldConfig {
+        faults: plan,
+        ..WorldConfig::default()
+    };
+    let mut world: World<MemEndpoint> = World::try_new(cfg, PatientMode::Script(script), || {
+        Ok::<_, std::convert::Infallible>(bus.endpoint())
+    })
     .expect("valid world");
     let mut sources: Vec<(SetpointSource, MemEndpoint)> = (0..5)
         .map(|f| {

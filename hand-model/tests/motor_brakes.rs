@@ -158,3 +158,64 @@ fn good_setpoints_never_brake_and_motion_stays_in_range() {
     );
     assert!(last.faults() & (1 << 5) != 0, "joint limit reported");
 }
+
+#[test]
+fn resumes_when_valid_setpoints_return_and_obeys_estop_release() {
+    use hand_dbc::messages::{EstopReason, EstopRequest, EstopSource, HandEstop};
+    use hand_model::dbc::seal;
+
+    let mut h = Harness::new();
+    let mut mc_ep = h.bus.endpoint();
+    let mut sp_ep = h.bus.endpoint();
+    let mut tool_ep = h.bus.endpoint();
+    let mut mc = FingerNode::try_new(FINGER, FingerConfig::default(), 0).expect("valid");
+    let mut sp = SetpointSource::try_new(FINGER, 0).expect("valid");
+    sp.set(FingerMode::Active, 3.0, 0.0).expect("in range");
+    let estop = |req: EstopRequest, counter: u8| {
+        let mut f = HandEstop::new(req, EstopSource::Tool, EstopReason::Technician)
+            .expect("valid")
+            .to_frame();
+        seal(&mut f, HandEstop::E2E, counter, false);
+        f
+    };
+    use embedded_can::nb::Can;
+    h.run(2_000_000, |t| {
+        match t {
+            500_000 => sp.set_corruption(SetpointCorruption::Silent),
+            800_000 => sp.set_corruption(SetpointCorruption::None),
+            1_200_000 => {
+                tool_ep
+                    .transmit(&estop(EstopRequest::Stop, 0))
+                    .expect("sent");
+            }
+            1_600_000 => {
+                tool_ep
+                    .transmit(&estop(EstopRequest::Release, 1))
+                    .expect("sent");
+            }
+            _ => {}
+        }
+        sp.poll(t, &mut sp_ep);
+        mc.poll(t, &mut mc_ep);
+    });
+    let state_at = |t0: u64| {
+        h.with_id(FingerStatus::IDS[FINGER])
+            .into_iter()
+            .rfind(|(t, _)| *t <= t0)
+            .map(|(_, f)| {
+                FingerStatus::decode(f.raw_id(), f.data())
+                    .expect("valid")
+                    .state()
+            })
+            .expect("status")
+    };
+    assert_eq!(state_at(480_000), FingerState::Active);
+    assert_eq!(state_at(780_000), FingerState::Braked, "timed out");
+    assert_eq!(
+        state_at(1_000_000),
+        FingerState::Active,
+        "recovered on valid setpoints"
+    );
+    assert_eq!(state_at(1_500_000), FingerState::Braked, "E-stop latched");
+    assert_eq!(state_at(1_900_000), FingerState::Active, "released");
+}

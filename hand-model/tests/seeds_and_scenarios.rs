@@ -8,12 +8,10 @@ use hand_dbc::messages::{EmgSamplesG0, FingerMode, FingerStatus};
 use hand_model::bus::MemEndpoint;
 use hand_model::dbc::CanFrame;
 use hand_model::emg::AmplifierConfig;
-use hand_model::faults::FaultPlan;
-use hand_model::finger::FingerConfig;
 use hand_model::nodes::{AmplifierNodeConfig, SetpointSource};
 use hand_model::patient::{CalibrationTrial, Intent, TrialKind};
 use hand_model::scenario::Scenario;
-use hand_model::world::{NodeSelection, PatientMode, World};
+use hand_model::world::{PatientMode, World, WorldConfig};
 
 fn world(h: &Harness, seed: u64, patient: PatientMode) -> World<MemEndpoint> {
     let bus = h.bus.clone();
@@ -24,15 +22,13 @@ fn world(h: &Harness, seed: u64, patient: PatientMode) -> World<MemEndpoint> {
         },
         ..AmplifierNodeConfig::default()
     };
-    World::try_new(
-        amp,
-        FingerConfig::default(),
-        patient,
-        FaultPlan::new(),
-        NodeSelection::default(),
-        0,
-        || Ok::<_, std::convert::Infallible>(bus.endpoint()),
-    )
+    let cfg = WorldConfig {
+        amplifier: amp,
+        ..WorldConfig::default()
+    };
+    World::try_new(cfg, patient, || {
+        Ok::<_, std::convert::Infallible>(bus.endpoint())
+    })
     .expect("valid world")
 }
 

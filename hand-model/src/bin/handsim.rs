@@ -15,7 +15,7 @@ use hand_model::finger::FingerConfig;
 use hand_model::nodes::{AmplifierNodeConfig, Bus};
 use hand_model::scenario::Scenario;
 use hand_model::socketcan_bus::SocketCanBus;
-use hand_model::world::{NodeSelection, World};
+use hand_model::world::{NodeSelection, World, WorldConfig};
 use hand_model::SimError;
 
 #[derive(Parser, Debug)]
@@ -148,23 +148,21 @@ fn run() -> Result<(), String> {
         },
         ..AmplifierNodeConfig::default()
     };
-    let nodes = NodeSelection {
-        amplifier: !args.no_amplifier,
-        fingers: parse_fingers(&args.fingers).map_err(|e| e.to_string())?,
+    let cfg = WorldConfig {
+        amplifier: amp,
+        finger: FingerConfig::default(),
+        faults: plan,
+        nodes: NodeSelection {
+            amplifier: !args.no_amplifier,
+            fingers: parse_fingers(&args.fingers).map_err(|e| e.to_string())?,
+        },
+        start_us: 0,
     };
     match (&args.iface, args.mem) {
         (Some(iface), false) => {
             let iface = iface.clone();
-            let world = World::try_new(
-                amp,
-                FingerConfig::default(),
-                run.patient,
-                plan,
-                nodes,
-                0,
-                || SocketCanBus::open(&iface),
-            )
-            .map_err(|e| e.to_string())?;
+            let world = World::try_new(cfg, run.patient, || SocketCanBus::open(&iface))
+                .map_err(|e| e.to_string())?;
             eprintln!(
                 "handsim: scenario {} on {iface} for {:.1} s (real time)",
                 scenario.name(),
@@ -176,15 +174,9 @@ fn run() -> Result<(), String> {
         (None, true) => {
             let bus = MemBus::new().with_capacity(1 << 22);
             let mut monitor = bus.endpoint();
-            let mut world = World::try_new(
-                amp,
-                FingerConfig::default(),
-                run.patient,
-                plan,
-                nodes,
-                0,
-                || Ok::<_, std::convert::Infallible>(bus.endpoint()),
-            )
+            let mut world = World::try_new(cfg, run.patient, || {
+                Ok::<_, std::convert::Infallible>(bus.endpoint())
+            })
             .map_err(|e| e.to_string())?;
             let mut per_id: BTreeMap<u32, u64> = BTreeMap::new();
             let mut t = 0;
@@ -226,15 +218,17 @@ fn run_realtime<B: Bus>(mut world: World<B>, duration_us: u64) {
         // 1 ms steps: the amplifier's frame period. Late wake-ups are caught up by the nodes.
         std::thread::sleep(Duration::from_micros(1000 - now % 1000));
     }
-    let amp = world.amplifier().stats();
-    eprintln!(
-        "handsim: done; {} frames sent, amplifier tx refused {} (queue full) / {} (errors), \
-{} samples skipped by stalls",
-        world.frames_sent(),
-        amp.tx_would_block,
-        amp.tx_errors,
-        world.amplifier().samples_dropped()
-    );
+    eprintln!("handsim: done; {} frames sent", world.frames_sent());
+    if let Some(amp) = world.amplifier() {
+        let st = amp.stats();
+        eprintln!(
+            "handsim: amplifier transmits refused: {} (queue full), {} (errors); {} samples \
+skipped by stalls",
+            st.tx_would_block,
+            st.tx_errors,
+            amp.samples_dropped()
+        );
+    }
 }
 
 fn main() -> ExitCode {
