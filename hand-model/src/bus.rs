@@ -101,21 +101,30 @@ impl<F> std::fmt::Debug for MemBus<F> {
     }
 }
 
-impl<F: Clone> Default for MemBus<F> {
+impl Default for MemBus<CanFrame> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl<F: Clone> MemBus<F> {
+// Constructors live on `MemBus<CanFrame>` (as `HashMap::new` lives on the default hasher), so
+// `MemBus::new()` needs no type annotation; other frame types use `for_frames`.
+impl MemBus<CanFrame> {
     /// A bus without clock (frames carry no receive time) and the default queue depth.
     pub fn new() -> Self {
-        Self::build(DEFAULT_QUEUE_CAPACITY, None)
+        Self::for_frames(None)
     }
 
     /// A bus whose endpoints stamp every received frame with `clock`'s time.
     pub fn with_clock(clock: impl Clock + Send + Sync + 'static) -> Self {
-        Self::build(DEFAULT_QUEUE_CAPACITY, Some(Arc::new(clock)))
+        Self::for_frames(Some(Arc::new(clock)))
+    }
+}
+
+impl<F: Clone> MemBus<F> {
+    /// A bus carrying frames of type `F`, optionally with a receive clock.
+    pub fn for_frames(clock: Option<Arc<dyn Clock + Send + Sync>>) -> Self {
+        Self::build(DEFAULT_QUEUE_CAPACITY, clock)
     }
 
     /// Sets the receive-queue depth of endpoints created from now on (at least 1).

@@ -84,8 +84,8 @@ pub enum Fault {
     BusFlood,
 }
 
-/// hand.dbc's ids, which an unknown-id burst must avoid.
-const DBC_IDS: [u16; 19] = [
+/// Ids an unknown-id burst must avoid: hand.dbc's, and 0x000/0x001 (the flood's).
+const RESERVED_IDS: [u16; 19] = [
     0x080, 0x100, 0x101, 0x102, 0x180, 0x200, 0x201, 0x202, 0x203, 0x204, 0x280, 0x281, 0x282,
     0x283, 0x284, 0x300, 0x301, 0x001, 0x000,
 ];
@@ -121,7 +121,7 @@ impl Fault {
                 bad(format!("{self:?}: channel mask must be 1..=0xFFF"))
             }
             Fault::UnknownIdBurst { id, count } => {
-                if id > 0x7FF || DBC_IDS.contains(&id) {
+                if id > 0x7FF || RESERVED_IDS.contains(&id) {
                     bad(format!("{self:?}: id must be an 11-bit id not used by hand.dbc (nor the flood's 0x001)"))
                 } else if count == 0 || count > 10_000 {
                     bad(format!("{self:?}: count must be 1..=10000"))

@@ -15,7 +15,7 @@ fn frame(id: u16, b: u8) -> CanFrame {
 #[test]
 fn every_other_endpoint_sees_each_frame_in_order_with_its_time() {
     let clock = VirtualClock::new();
-    let bus: MemBus = MemBus::with_clock(clock.clone());
+    let bus = MemBus::with_clock(clock.clone());
     let mut a = bus.endpoint();
     let mut b = bus.endpoint();
     let mut c = bus.endpoint();
@@ -40,7 +40,7 @@ fn every_other_endpoint_sees_each_frame_in_order_with_its_time() {
 
 #[test]
 fn full_queues_drop_the_newest_and_count_it() {
-    let bus: MemBus = MemBus::new().with_capacity(3);
+    let bus = MemBus::new().with_capacity(3);
     let mut tx = bus.endpoint();
     let mut rx = bus.endpoint();
     for i in 0..5 {
@@ -56,7 +56,7 @@ fn full_queues_drop_the_newest_and_count_it() {
 
 #[test]
 fn bus_off_refuses_transmits() {
-    let bus: MemBus = MemBus::new();
+    let bus = MemBus::new();
     let mut a = bus.endpoint();
     let _b = bus.endpoint();
     bus.set_bus_off(true);
@@ -70,7 +70,7 @@ fn bus_off_refuses_transmits() {
 
 #[test]
 fn blocking_receive_waits_for_another_thread_and_refuses_to_wait_alone() {
-    let bus: MemBus = MemBus::new();
+    let bus = MemBus::new();
     let mut rx = bus.endpoint();
     let mut tx = bus.endpoint();
     let h = std::thread::spawn(move || {
