@@ -2,7 +2,10 @@
 //! - `chain/tick_12ch_50_samples`: one daemon tick, 12 channels x 50 new samples through the
 //!   filters, then the 96 features;
 //! - `chain/batch_1s_12ch`: the offline path over one second (1000 samples) of 12-channel
-//!   signal, including the chain's construction.
+//!   signal, including the chain's construction;
+//! - `chain/filter_60s_12ch`: only the filters (DC, band-pass, notch) over 60 s of 12-channel
+//!   signal, to compare with `scipy.signal.sosfilt` on the same shape
+//!   (`decoder/ref/sosfilt_timing.py`).
 //!
 //!
 //! Each is measured twice: wall time (criterion's default) and the benchmark thread's CPU time
@@ -16,7 +19,7 @@
 
 use cpu_time::ThreadTime;
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
-use decoder::dsp::{batch_features, Chain, ChainConfig};
+use decoder::dsp::{batch_features, batch_filtered, Chain, ChainConfig};
 use std::time::Duration;
 
 /// Deterministic EMG-like noise (xorshift), `n` samples of `channels` channels, row-major.
@@ -46,6 +49,7 @@ fn bench_chain(c: &mut Criterion) {
     let ch = settings.n_channels();
     let step = settings.step_len();
     let data = signal(10_000, ch);
+    assert!(settings.cascade().len() == 6);
     let mut group = c.benchmark_group("chain");
 
     let mut chain = Chain::new(&settings);
@@ -79,6 +83,17 @@ fn bench_chain(c: &mut Criterion) {
         b.iter_custom(|iters| {
             cpu_time_of(iters, || {
                 black_box(batch_features(&settings, black_box(one_second)));
+            })
+        })
+    });
+
+    let minute = signal(60_000, ch);
+    group.throughput(Throughput::Elements(60_000));
+    group.sample_size(20);
+    group.bench_function("filter_60s_12ch_cpu", |b| {
+        b.iter_custom(|iters| {
+            cpu_time_of(iters, || {
+                black_box(batch_filtered(&settings, black_box(&minute)).expect("whole samples"));
             })
         })
     });

@@ -1,7 +1,9 @@
 //! Properties of the chain (proptest): linear scaling of the features, decay of a constant
 //! input, the notch's attenuation of mains, and streaming = batch bit for bit.
 
-use decoder::dsp::{batch_features, Chain, ChainConfig, ChainSettings, FeatureSignal};
+use decoder::dsp::{
+    batch_features, batch_filtered, Chain, ChainConfig, ChainSettings, FeatureSignal,
+};
 use proptest::prelude::*;
 use std::f64::consts::PI;
 
@@ -99,10 +101,14 @@ proptest! {
         let x = signal(seed, n, channels);
         let batch = batch_features(&s, &x);
         let mut chain = Chain::new(&s);
+        let filtered = batch_filtered(&s, &x).expect("whole samples");
         let mut rows = Vec::new();
-        for sample in x.chunks_exact(channels) {
+        for (sample, want) in x.chunks_exact(channels).zip(filtered.chunks_exact(channels)) {
             if chain.push(sample) {
                 rows.extend_from_slice(chain.features());
+            }
+            for (a, b) in chain.last_filtered().iter().zip(want) {
+                prop_assert_eq!(a.to_bits(), b.to_bits());
             }
         }
         prop_assert_eq!(batch.n_rows, s.n_windows(n));

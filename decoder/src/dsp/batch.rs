@@ -91,14 +91,16 @@ pub fn batch_features(settings: &ChainSettings, samples: &[f64]) -> FeatureMatri
 }
 
 /// The filtered signal (after the notch, before rectification) of one recording, row-major
-/// `n x channels`, from a fresh [`Chain`].
+/// `n x channels`, from a fresh [`Chain`]: equal to [`Chain::last_filtered`] after each
+/// [`Chain::push`], bit for bit.
 pub fn batch_filtered(settings: &ChainSettings, samples: &[f64]) -> Result<Vec<f64>, BatchError> {
     check_shape(settings, samples)?;
     let channels = settings.n_channels();
     let mut out = Vec::with_capacity(samples.len());
     let mut chain = Chain::new(settings);
     for sample in samples.chunks_exact(channels) {
-        chain.push(sample);
+        // The filter half of `push` alone: the same code, without windows and features.
+        chain.filter_sample(sample);
         out.extend_from_slice(chain.last_filtered());
     }
     Ok(out)

@@ -91,13 +91,10 @@ impl Chain {
         }
     }
 
-    /// Feeds one multi-channel sample (one value per channel, in channel order). Returns true
-    /// when a new feature vector is ready in [`Chain::features`].
-    ///
-    /// A NaN, infinite or absurdly large value is counted in [`Chain::faults`], resets that
-    /// channel's filter state and is filtered as 0. A slice of the wrong length is counted too;
-    /// missing channels are treated as non-finite, extra values are ignored.
-    pub fn push(&mut self, sample: &[f64]) -> bool {
+    /// The filter half of [`Chain::push`]: validates the sample, runs the cascade and leaves the
+    /// filtered values in `last_filtered`; the window and features are not touched. Used alone
+    /// by [`super::batch_filtered`].
+    pub(crate) fn filter_sample(&mut self, sample: &[f64]) {
         let n = self.n_channels;
         self.count += 1;
         self.faults.set_now(self.count);
@@ -135,7 +132,17 @@ impl Chain {
                 *x = y;
             }
         }
+    }
 
+    /// Feeds one multi-channel sample (one value per channel, in channel order). Returns true
+    /// when a new feature vector is ready in [`Chain::features`].
+    ///
+    /// A NaN, infinite or absurdly large value is counted in [`Chain::faults`], resets that
+    /// channel's filter state and is filtered as 0. A slice of the wrong length is counted too;
+    /// missing channels are treated as non-finite, extra values are ignored.
+    pub fn push(&mut self, sample: &[f64]) -> bool {
+        self.filter_sample(sample);
+        let work = &self.last_filtered[..self.n_channels];
         let w = self.window_len;
         let head = self.head;
         for (ch, &y) in work.iter().enumerate() {
