@@ -3,6 +3,11 @@
 //!
 //! `cargo bench -p hand-dbc --bench emg_decode`
 
+#![allow(
+    missing_docs,
+    reason = "criterion_group! generates an undocumented pub fn"
+)]
+
 use std::hint::black_box;
 use std::time::Duration;
 
