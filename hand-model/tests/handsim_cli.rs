@@ -49,6 +49,45 @@ fn runs_a_scenario_with_faults_on_the_memory_bus_and_writes_trials() {
 }
 
 #[test]
+fn writes_a_calibration_session_directory() {
+    let dir = std::env::temp_dir().join(format!("handsim-session-{}", std::process::id()));
+    let out = handsim(&[
+        "--mem",
+        "--scenario",
+        "calibration-quick",
+        "--session-out",
+        dir.to_str().expect("utf-8 path"),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let log = hand_dbc::candump::read_log(dir.join("frames.log")).expect("candump log");
+    let meta = std::fs::read_to_string(dir.join("session.toml")).expect("session.toml");
+    let value: toml::Value = toml::from_str(&meta).expect("toml");
+    let trials = value["trial"].as_array().expect("trials");
+    assert_eq!(trials.len(), 13);
+    // The log covers every trial, and EMG arrives at 3 frames per ms throughout.
+    let last_end = trials
+        .iter()
+        .filter_map(|t| t["end_us"].as_integer())
+        .max()
+        .expect("end");
+    let log_end = log.last().expect("frames").time_us;
+    assert!(
+        log_end as i64 >= last_end,
+        "log ends at {log_end}, trials at {last_end}"
+    );
+    let emg = log
+        .iter()
+        .filter(|e| (0x100..=0x102).contains(&e.frame.raw_id()))
+        .count() as u64;
+    assert_eq!(emg, 3 * (log_end / 1000 + 1));
+    std::fs::remove_dir_all(&dir).expect("cleanup");
+}
+
+#[test]
 fn a_missing_interface_is_a_clear_error() {
     let out = handsim(&[
         "--iface",
@@ -74,6 +113,7 @@ fn bad_arguments_are_refused() {
         vec!["--mem", "--fault", "estop@2..1"],
         vec!["--mem", "--fingers", "7"],
         vec!["--scenario", "rest"],
+        vec!["--session-out", "/tmp/x", "--scenario", "rest"],
     ] {
         let out = handsim(&args);
         assert!(!out.status.success(), "{args:?} accepted");

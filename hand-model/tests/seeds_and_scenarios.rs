@@ -64,8 +64,8 @@ fn calibration_scenario_produces_the_trials() {
     // 5 fingers + whole hand, flexion and extension each, plus one rest trial.
     assert_eq!(run.trials.len(), 13);
     for (i, t) in run.trials.iter().enumerate() {
-        assert_eq!(t.id, i);
-        assert_eq!(t.repetition, 0);
+        assert_eq!(t.id, i + 1);
+        assert_eq!(t.repetition, 1);
         assert_eq!(t.end_us - t.start_us, 500_000);
         assert!(t.end_us <= run.duration_us);
     }
@@ -87,7 +87,7 @@ fn calibration_scenario_produces_the_trials() {
     assert_eq!(run.trials[12].kind, TrialKind::Rest);
     let full = Scenario::Calibration.build(1).expect("valid");
     assert_eq!(full.trials.len(), 39);
-    assert_eq!(full.trials.last().map(|t| t.repetition), Some(2));
+    assert_eq!(full.trials.last().map(|t| t.repetition), Some(3));
 
     // The metadata round-trips through the session.toml form.
     let text = run.trials_toml().expect("serialise");
@@ -101,6 +101,18 @@ fn calibration_scenario_produces_the_trials() {
     }
     let back: Doc = toml::from_str(&text).expect("parse");
     assert_eq!(back.trial, run.trials);
+
+    // The whole session.toml carries the chain basics and the recording next to the trials.
+    let session = run
+        .session_toml("frames.log", &AmplifierConfig::default())
+        .expect("serialise");
+    let value: toml::Value = toml::from_str(&session).expect("parse");
+    assert_eq!(value["format_version"].as_integer(), Some(1));
+    assert_eq!(value["chain"]["channels"].as_integer(), Some(12));
+    assert_eq!(value["chain"]["mains_hz"].as_integer(), Some(50));
+    assert_eq!(value["recording"]["format"].as_str(), Some("candump"));
+    assert_eq!(value["recording"]["file"].as_str(), Some("frames.log"));
+    assert_eq!(value["trial"].as_array().map(Vec::len), Some(13));
 
     // During each trial's plateau the patient does what the trial says.
     let hand_model::world::PatientMode::Script(mut script) = run.patient else {

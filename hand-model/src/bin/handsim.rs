@@ -7,8 +7,9 @@ use std::process::ExitCode;
 use std::time::Duration;
 
 use clap::Parser;
+use hand_dbc::candump::LogWriter;
 use hand_model::bus::MemBus;
-use hand_model::clock::{Clock, SystemClock};
+use hand_model::clock::{Clock, SystemClock, VirtualClock};
 use hand_model::emg::AmplifierConfig;
 use hand_model::faults::{Fault, FaultPlan};
 use hand_model::finger::FingerConfig;
@@ -52,6 +53,10 @@ struct Args {
     /// Write the scenario's calibration trials (session.toml `[[trial]]` form) to this file.
     #[arg(long)]
     trials_out: Option<std::path::PathBuf>,
+    /// With --mem: write a calibration session directory (frames.log in candump format and
+    /// session.toml with the trials), ready for decoder::session.
+    #[arg(long, requires = "mem")]
+    session_out: Option<std::path::PathBuf>,
     /// List the scenarios and faults, then exit.
     #[arg(long)]
     list_scenarios: bool,
@@ -140,12 +145,20 @@ fn run() -> Result<(), String> {
         60 => hand_model::emg::Mains::Hz60,
         m => return Err(format!("--mains {m}: must be 50 or 60")),
     };
+    let amp_signal = AmplifierConfig {
+        seed: args.seed,
+        mains,
+        ..AmplifierConfig::default()
+    };
+    let session_toml = match &args.session_out {
+        Some(_) => Some(
+            run.session_toml("frames.log", &amp_signal)
+                .map_err(|e| e.to_string())?,
+        ),
+        None => None,
+    };
     let amp = AmplifierNodeConfig {
-        signal: AmplifierConfig {
-            seed: args.seed,
-            mains,
-            ..AmplifierConfig::default()
-        },
+        signal: amp_signal,
         ..AmplifierNodeConfig::default()
     };
     let cfg = WorldConfig {
@@ -172,7 +185,19 @@ fn run() -> Result<(), String> {
             Ok(())
         }
         (None, true) => {
-            let bus = MemBus::new().with_capacity(1 << 22);
+            let clock = VirtualClock::new();
+            let bus = MemBus::with_clock(clock.clone()).with_capacity(1 << 22);
+            let mut log = match &args.session_out {
+                Some(dir) => {
+                    std::fs::create_dir_all(dir)
+                        .map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+                    let path = dir.join("frames.log");
+                    let file = std::fs::File::create(&path)
+                        .map_err(|e| format!("cannot create {}: {e}", path.display()))?;
+                    Some((LogWriter::new(std::io::BufWriter::new(file)), path))
+                }
+                None => None,
+            };
             let mut monitor = bus.endpoint();
             let mut world = World::try_new(cfg, run.patient, || {
                 Ok::<_, std::convert::Infallible>(bus.endpoint())
@@ -181,11 +206,25 @@ fn run() -> Result<(), String> {
             let mut per_id: BTreeMap<u32, u64> = BTreeMap::new();
             let mut t = 0;
             while t <= duration_us {
+                clock.set_us(t);
                 world.step(t);
                 while let Some(r) = monitor.receive_timestamped() {
                     *per_id.entry(r.frame.raw_id()).or_default() += 1;
+                    if let Some((w, path)) = &mut log {
+                        w.write_frame(r.time_us.unwrap_or(t), "can0", &r.frame)
+                            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+                    }
                 }
                 t += 1000;
+            }
+            if let (Some((mut w, path)), Some(dir), Some(text)) =
+                (log, &args.session_out, &session_toml)
+            {
+                w.flush()
+                    .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+                let meta = dir.join("session.toml");
+                std::fs::write(&meta, text)
+                    .map_err(|e| format!("cannot write {}: {e}", meta.display()))?;
             }
             let secs = duration_us as f64 * 1e-6;
             println!(

@@ -36,7 +36,7 @@ impl TrialKind {
 /// outside `[start_us, end_us)`, so every sample inside a trial has the trial's label).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct CalibrationTrial {
-    /// 0-based trial number in protocol order.
+    /// Trial number in protocol order, from 1 (unique in the session).
     pub id: usize,
     /// The finger (0 thumb ..= 4 pinky), or `None` for all fingers (serialised as `"all"`).
     #[serde(with = "finger_serde")]
@@ -47,7 +47,8 @@ pub struct CalibrationTrial {
     pub start_us: u64,
     /// End of the plateau (exclusive), µs from the session start.
     pub end_us: u64,
-    /// 0-based repetition of the protocol this trial belongs to.
+    /// Repetition of the protocol this trial belongs to, from 1 (decoder::session's
+    /// convention).
     pub repetition: usize,
 }
 
@@ -177,7 +178,7 @@ impl CalibrationProtocol {
             targets.push(None);
         }
         script.rest(self.rest_us);
-        for repetition in 0..self.repetitions {
+        for repetition in 1..=self.repetitions {
             for &finger in &targets {
                 for kind in [TrialKind::Flexion, TrialKind::Extension] {
                     let target = target_intent(finger, kind.sign() * self.level)?;
@@ -185,7 +186,7 @@ impl CalibrationProtocol {
                     let start_us = script.duration_us();
                     script.hold(target, self.hold_us);
                     trials.push(CalibrationTrial {
-                        id: trials.len(),
+                        id: trials.len() + 1,
                         finger,
                         kind,
                         start_us,
@@ -201,7 +202,7 @@ impl CalibrationProtocol {
                 let start_us = script.duration_us();
                 script.rest(self.hold_us);
                 trials.push(CalibrationTrial {
-                    id: trials.len(),
+                    id: trials.len() + 1,
                     finger: None,
                     kind: TrialKind::Rest,
                     start_us,
