@@ -56,8 +56,10 @@ mod sos;
 
 pub use batch::{batch_features, batch_filtered, try_batch_features, BatchError, FeatureMatrix};
 pub use chain::Chain;
-pub use config::{ChainConfig, ChainSettings, ConfigError, FeatureSignal};
+pub use config::{
+    ChainConfig, ChainSettings, ConfigError, FeatureSignal, MAX_CHANNELS, MAX_ORDER, Q_RANGE,
+};
 pub use design::{butter_bandpass, dc_highpass, iirnotch};
-pub use faults::Faults;
+pub use faults::{Faults, MAX_ABS_SAMPLE};
 pub use features::{window_features, FEATURES_PER_CHANNEL, FEATURE_NAMES};
 pub use sos::Sos;
