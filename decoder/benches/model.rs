@@ -12,6 +12,7 @@
 // criterion_group! generates an undocumented `pub fn`.
 #![allow(missing_docs)]
 
+use cpu_time::ThreadTime;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use decoder::dsp::{Chain, ChainConfig};
 use decoder::model::{
@@ -31,6 +32,16 @@ impl Gen {
         z ^= z >> 31;
         (z >> 11) as f64 / (1u64 << 53) as f64
     }
+}
+
+/// CPU time of this thread for `iters` calls of `f` (the 2-core machine is shared, so wall time
+/// includes time the thread spent preempted).
+fn cpu_time_of<R>(iters: u64, mut f: impl FnMut() -> R) -> Duration {
+    let start = ThreadTime::now();
+    for _ in 0..iters {
+        black_box(f());
+    }
+    start.elapsed()
 }
 
 fn summary(kind: ModelKind) -> TrainingSummary {
@@ -98,6 +109,9 @@ fn bench_models(c: &mut Criterion) {
         group.bench_function(format!("predict_{kind}"), |b| {
             b.iter(|| p.run(black_box(&x)))
         });
+        group.bench_function(format!("predict_{kind}_cpu"), |b| {
+            b.iter_custom(|iters| cpu_time_of(iters, || p.run(black_box(&x))))
+        });
     }
 
     let settings = ChainConfig::default().validate().expect("defaults");
@@ -111,17 +125,19 @@ fn bench_models(c: &mut Criterion) {
     let ticks: Vec<&[f64]> = signal.chunks_exact(settings.step_len() * ch).collect();
     let mut p = trained_random(ModelKind::ResDd).predictor();
     let mut i = 0;
-    group.bench_function("tick_chain_resdd", |b| {
-        b.iter(|| {
-            let t = ticks[i % ticks.len()];
-            i += 1;
-            let mut ready = false;
-            for s in t.chunks_exact(ch) {
-                ready |= chain.push(s);
-            }
-            assert!(ready);
-            p.run(chain.features())
-        })
+    let mut tick = move || {
+        let t = ticks[i % ticks.len()];
+        i += 1;
+        let mut ready = false;
+        for s in t.chunks_exact(ch) {
+            ready |= chain.push(black_box(s));
+        }
+        assert!(ready);
+        p.run(chain.features())
+    };
+    group.bench_function("tick_chain_resdd", |b| b.iter(&mut tick));
+    group.bench_function("tick_chain_resdd_cpu", |b| {
+        b.iter_custom(|iters| cpu_time_of(iters, &mut tick))
     });
 
     let data = calibration(100);
@@ -132,19 +148,15 @@ fn bench_models(c: &mut Criterion) {
     let mut epochs = 0;
     group.sample_size(10);
     group.measurement_time(Duration::from_secs(5));
-    group.bench_function("train_resdd_calibration", |b| {
-        b.iter(|| {
-            let m = train(
-                ModelKind::ResDd,
-                &ModelSpec::default(),
-                &data,
-                &cfg,
-                &mut |_| {},
-            )
-            .expect("trains");
-            epochs = m.summary().epochs_run;
-            m
-        })
+    let spec = ModelSpec::default();
+    let mut run = || {
+        let m = train(ModelKind::ResDd, &spec, &data, &cfg, &mut |_| {}).expect("trains");
+        epochs = m.summary().epochs_run;
+        m
+    };
+    group.bench_function("train_resdd_calibration", |b| b.iter(&mut run));
+    group.bench_function("train_resdd_calibration_cpu", |b| {
+        b.iter_custom(|iters| cpu_time_of(iters, &mut run))
     });
     println!(
         "train_resdd_calibration: {} windows, {epochs} epochs per run",

@@ -77,6 +77,15 @@ fn save_load_round_trip_is_bit_exact_for_every_kind() {
         let x: Vec<f64> = (0..16).map(|i| 10.0 * i as f64).collect();
         let (a, b) = (m.predict(&x), back.predict(&x));
         assert_eq!(a.map(f64::to_bits), b.map(f64::to_bits));
+        // The batch path and the daemon's path give the very same numbers.
+        let rows: Vec<f64> = x.iter().chain(x.iter().rev()).copied().collect();
+        let batch = back.predict_rows(&rows);
+        assert_eq!(batch.len(), 2);
+        assert_eq!(batch[0].map(f64::to_bits), a.map(f64::to_bits));
+        assert_eq!(
+            back.predictor().run(&rows[16..]).map(f64::to_bits),
+            batch[1].map(f64::to_bits)
+        );
         assert_eq!(back.sample_rate_hz(), 1000.0);
         assert_eq!(back.n_channels(), 2);
         // Also loads without a chain to compare against (e.g. for `handctl info`).

@@ -136,7 +136,7 @@ pub struct TrainConfig {
     pub batch_size: usize,
     /// Upper bound on epochs (default 200).
     pub max_epochs: usize,
-    /// Epochs without validation improvement before stopping (default 20).
+    /// Epochs without validation improvement before stopping (default 20; at least 1).
     pub patience: usize,
     /// Smallest decrease of the validation loss that counts as an improvement (default 1e-6).
     pub min_delta: f64,
@@ -176,6 +176,9 @@ impl TrainConfig {
                 "max_epochs must be in 1..=1000000, got {}",
                 self.max_epochs
             ));
+        }
+        if self.patience == 0 {
+            return bad("patience must be at least 1 epoch, got 0".into());
         }
         if !(self.min_delta >= 0.0 && self.min_delta.is_finite()) {
             return bad(format!(

@@ -219,7 +219,7 @@ pub fn train(
             val_loss,
             best_epoch,
         });
-        if has_val && since_best >= cfg.patience.max(1) {
+        if has_val && since_best >= cfg.patience {
             stopped_early = epoch < cfg.max_epochs;
             break;
         }

@@ -98,10 +98,28 @@ impl TrainedModel {
         &self.summary
     }
 
-    /// Labels for one raw feature vector (normalized here). Allocates; for offline use — the
-    /// daemon uses a [`Predictor`].
+    /// Labels for one raw feature vector (normalized here). Allocates scratch; for offline use
+    /// (the daemon uses a [`Predictor`]). Panics if `features` has the wrong length.
     pub fn predict(&self, features: &[f64]) -> [f64; N_FINGERS] {
-        self.predictor().run(features)
+        let mut xn = vec![0.0; self.normalizer.len()];
+        self.normalizer.apply(features, &mut xn);
+        let mut y = [0.0; N_FINGERS];
+        self.model.predict(&xn, &mut y);
+        y
+    }
+
+    /// Labels for many raw feature vectors stored row-major in `rows` (e.g. a
+    /// `FeatureMatrix`'s data), reusing one scratch. Panics if `rows.len()` is not a multiple of
+    /// the feature count.
+    pub fn predict_rows(&self, rows: &[f64]) -> Vec<[f64; N_FINGERS]> {
+        let n = self.normalizer.len();
+        assert!(
+            rows.len().is_multiple_of(n),
+            "{} values are not whole rows of {n} features",
+            rows.len()
+        );
+        let mut p = self.predictor();
+        rows.chunks_exact(n).map(|r| p.run(r)).collect()
     }
 
     /// A reusable, allocation-free runner (allocates its buffers once, here).
