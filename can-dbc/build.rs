@@ -713,7 +713,7 @@ fn gen_group(o: &mut String, g: &Group) -> Res<()> {
         );
     }
     o.push_str(&doc(&d));
-    let _ = writeln!(o, "#[derive(Debug, Clone, Copy, PartialEq)]");
+    let _ = writeln!(o, "#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]");
     let _ = writeln!(o, "pub struct {ty} {{");
     if fam {
         let _ = writeln!(o, "    instance: u8,");
@@ -1228,7 +1228,7 @@ fn id_pattern(g: &Group) -> String {
 
 fn gen_dispatch(o: &mut String, groups: &[Group]) {
     let _ = writeln!(o, "/// Any message of hand.dbc, as decoded by [`decode`].");
-    let _ = writeln!(o, "#[derive(Debug, Clone, Copy, PartialEq)]");
+    let _ = writeln!(o, "#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]");
     let _ = writeln!(o, "pub enum Message {{");
     for g in groups {
         let _ = writeln!(o, "    /// {}", g.name);

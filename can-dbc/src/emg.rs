@@ -271,6 +271,10 @@ impl EmgAssembler {
 
     /// Feeds one frame received at `received_us`; every sample it completes or forces out
     /// (bridged) is handed to `sink`, in counter order.
+    ///
+    /// `received_us` must be the frame's own receive time (e.g. the SocketCAN timestamp or the
+    /// candump log time), not the time a batch of frames was read: frames read once per 50 ms
+    /// tick and stamped with the read time would look like 50 ms gaps.
     pub fn push(&mut self, frame: &EmgFrame, received_us: u64, sink: &mut impl FnMut(&EmgSample)) {
         if let Some(last) = self.last_rx_us {
             if received_us.saturating_sub(last) > self.max_gap_us {
