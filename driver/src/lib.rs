@@ -4,10 +4,13 @@
 pub mod conditioner;
 pub mod config;
 pub mod control;
+pub mod daemon;
+pub mod engine;
 pub mod protocol;
 pub mod rt;
 pub mod safety;
 pub mod stats;
+pub mod transport;
 pub mod tuning;
 pub mod units;
 

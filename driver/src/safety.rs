@@ -1,7 +1,7 @@
 //! The daemon's safety state machine: BOOT -> READY -> RUNNING, and SAFE on a fault.
 //!
 //! Transient faults (EMG silence, sporadic E2E errors, an invalid window, non-finite values in
-//! the chain) leave SAFE by themselves once no transient fault has been raised for the recovery
+//! the chain, a saturated or lead-off channel) leave SAFE by themselves once no transient fault has been raised for the recovery
 //! time (500 ms by default). Latched faults (E-stop, bus-off or interface down, repeated E2E
 //! failure, model error, a technician's stop) stay until an explicit `arm`. Sporadic E2E errors
 //! become a latched fault when `e2e_latch_count` of them fall within `e2e_latch_window_us`.
@@ -58,6 +58,9 @@ pub enum Fault {
     InvalidWindow,
     /// NaN or infinity in the chain or the model output.
     NonFinite,
+    /// A channel at the ADC rail (saturation, or lead-off picking up mains), from the samples
+    /// themselves or from EMG_STATUS.
+    SignalQuality,
     /// A HAND_ESTOP frame arrived.
     EStop,
     /// The controller went bus-off or error-passive.
@@ -74,11 +77,12 @@ pub enum Fault {
 
 impl Fault {
     /// All faults, in bit order.
-    pub const ALL: [Fault; 10] = [
+    pub const ALL: [Fault; 11] = [
         Fault::EmgSilence,
         Fault::E2eError,
         Fault::InvalidWindow,
         Fault::NonFinite,
+        Fault::SignalQuality,
         Fault::EStop,
         Fault::BusOff,
         Fault::InterfaceDown,
@@ -112,6 +116,7 @@ impl Fault {
             Fault::E2eError => "e2e_error",
             Fault::InvalidWindow => "invalid_window",
             Fault::NonFinite => "non_finite",
+            Fault::SignalQuality => "signal_quality",
             Fault::EStop => "estop",
             Fault::BusOff => "bus_off",
             Fault::InterfaceDown => "interface_down",

@@ -1,0 +1,271 @@
+//! The daemon's loop around the [`Engine`]: absolute deadlines every tick, all frames read
+//! between ticks, technicians' commands applied at the tick, the bus's health handled (stop
+//! sending, drop queued frames, reopen with backoff, come back in SAFE), and a status snapshot
+//! published for `handctl status`.
+//!
+//! [`Runner::step`] does one tick at a given time, so tests drive it on a virtual clock;
+//! [`Runner::run_realtime`] sleeps to each absolute deadline on the system clock.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::Receiver;
+use std::sync::{Arc, Mutex};
+
+use hand_model::Clock;
+
+use crate::conditioner::{FingerGains, Setpoint};
+use crate::engine::{Command, Counters, Engine};
+use crate::safety::{DaemonState, Fault, FaultSet, FingerEvent};
+use crate::stats::Percentiles;
+use crate::transport::{Transport, TransportError};
+use crate::units::{FINGER_NAMES, N_FINGERS};
+
+/// What `handctl status` shows, copied out of the loop every tick without allocating.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Snapshot {
+    /// State.
+    pub state: DaemonState,
+    /// Faults in force.
+    pub faults: FaultSet,
+    /// Counters since start.
+    pub counters: Counters,
+    /// Newest sample frame -> setpoints written.
+    pub latency: Percentiles,
+    /// Compute time per tick.
+    pub compute: Percentiles,
+    /// Raw model labels.
+    pub labels: [f64; N_FINGERS],
+    /// Setpoints sent.
+    pub setpoints: [Setpoint; N_FINGERS],
+    /// Forces the controllers report.
+    pub reported_force: [f64; N_FINGERS],
+    /// Disabled fingers.
+    pub disabled: [bool; N_FINGERS],
+    /// Gains in force.
+    pub gains: [FingerGains; N_FINGERS],
+    /// Whether the bus is usable.
+    pub bus_ok: bool,
+}
+
+impl Default for Snapshot {
+    fn default() -> Self {
+        Self {
+            state: DaemonState::Boot,
+            faults: FaultSet::default(),
+            counters: Counters::default(),
+            latency: Percentiles::default(),
+            compute: Percentiles::default(),
+            labels: [0.0; N_FINGERS],
+            setpoints: [Setpoint::default(); N_FINGERS],
+            reported_force: [0.0; N_FINGERS],
+            disabled: [false; N_FINGERS],
+            gains: [FingerGains::default(); N_FINGERS],
+            bus_ok: true,
+        }
+    }
+}
+
+/// The snapshot shared with the control thread.
+pub type SharedSnapshot = Arc<Mutex<Snapshot>>;
+
+/// First and longest wait between attempts to reopen a failed bus, µs.
+pub const REOPEN_BACKOFF_US: (u64, u64) = (100_000, 2_000_000);
+
+/// The loop.
+pub struct Runner<T: Transport, K: Clock> {
+    engine: Engine,
+    transport: T,
+    clock: K,
+    tick_us: u64,
+    next_deadline_us: u64,
+    bus_ok: bool,
+    backoff_us: u64,
+    next_reopen_us: u64,
+    commands: Option<Receiver<Command>>,
+    snapshot: SharedSnapshot,
+    last_tick_on_time: bool,
+}
+
+impl<T: Transport, K: Clock> Runner<T, K> {
+    /// A loop whose first tick is due one period from now.
+    pub fn new(engine: Engine, transport: T, clock: K, tick_us: u64) -> Self {
+        let now = clock.now_us();
+        Self {
+            engine,
+            transport,
+            clock,
+            tick_us,
+            next_deadline_us: now + tick_us,
+            bus_ok: true,
+            backoff_us: REOPEN_BACKOFF_US.0,
+            next_reopen_us: 0,
+            commands: None,
+            snapshot: Arc::new(Mutex::new(Snapshot::default())),
+            last_tick_on_time: true,
+        }
+    }
+
+    /// Commands from the control thread.
+    pub fn with_commands(mut self, rx: Receiver<Command>) -> Self {
+        self.commands = Some(rx);
+        self
+    }
+
+    /// The snapshot the loop publishes.
+    pub fn snapshot(&self) -> SharedSnapshot {
+        Arc::clone(&self.snapshot)
+    }
+
+    /// The engine (tests and the demo read it).
+    pub fn engine(&self) -> &Engine {
+        &self.engine
+    }
+
+    /// Mutable access to the engine (to mark it validated, or to inject a fault in tests).
+    pub fn engine_mut(&mut self) -> &mut Engine {
+        &mut self.engine
+    }
+
+    /// When the next tick is due, µs.
+    pub fn next_deadline_us(&self) -> u64 {
+        self.next_deadline_us
+    }
+
+    /// Whether the last tick started on time (the watchdog is fed only then).
+    pub fn last_tick_on_time(&self) -> bool {
+        self.last_tick_on_time
+    }
+
+    fn bus_failed(&mut self, now_us: u64, e: &TransportError) {
+        let fault = match e {
+            TransportError::BusOff | TransportError::ErrorPassive => Fault::BusOff,
+            _ => Fault::InterfaceDown,
+        };
+        if self.bus_ok {
+            tracing::error!(error = %e, "bus failed: sending stops, queued setpoints dropped");
+        }
+        self.engine.raise(now_us, fault);
+        self.transport.drop_queued();
+        if self.bus_ok {
+            self.bus_ok = false;
+            self.backoff_us = REOPEN_BACKOFF_US.0;
+            self.next_reopen_us = now_us + self.backoff_us;
+        }
+    }
+
+    fn try_reopen(&mut self, now_us: u64) {
+        if self.bus_ok || now_us < self.next_reopen_us {
+            return;
+        }
+        match self.transport.reopen() {
+            Ok(()) => {
+                tracing::warn!("bus reopened; the daemon stays SAFE until `handctl arm`");
+                self.bus_ok = true;
+            }
+            Err(e) => {
+                self.backoff_us = (self.backoff_us * 2).min(REOPEN_BACKOFF_US.1);
+                self.next_reopen_us = now_us + self.backoff_us;
+                tracing::debug!(error = %e, retry_in_us = self.backoff_us, "bus reopen failed");
+            }
+        }
+    }
+
+    /// Read every waiting frame into the engine.
+    pub fn drain(&mut self) {
+        if !self.bus_ok {
+            return;
+        }
+        loop {
+            match self.transport.try_recv() {
+                Ok(Some((frame, rx_us))) => self.engine.on_frame(&frame, rx_us),
+                Ok(None) => break,
+                Err(e) => {
+                    let now = self.clock.now_us();
+                    self.bus_failed(now, &e);
+                    break;
+                }
+            }
+        }
+    }
+
+    /// One tick: drain the bus, apply commands, run the engine, send its frames, publish the
+    /// snapshot, and move the deadline on by one period (absolute, so there is no drift).
+    pub fn step(&mut self) {
+        let now = self.clock.now_us();
+        self.try_reopen(now);
+        self.drain();
+        if let Some(rx) = &self.commands {
+            while let Ok(cmd) = rx.try_recv() {
+                if let Err(e) = self.engine.command(now, cmd) {
+                    tracing::warn!(error = %e, "command refused");
+                }
+            }
+        }
+        let deadline = self.next_deadline_us;
+        let t0 = self.clock.now_us();
+        self.last_tick_on_time = t0 <= deadline + self.tick_us / 10;
+        let frames = self.engine.tick(t0, deadline);
+        let mut failed = None;
+        if self.bus_ok {
+            for f in frames {
+                if let Err(e) = self.transport.send(f) {
+                    failed = Some(e);
+                    break;
+                }
+            }
+        }
+        let t1 = self.clock.now_us();
+        if let Some(e) = failed {
+            self.bus_failed(t1, &e);
+        }
+        self.engine.written(t1, t1.saturating_sub(t0));
+        self.engine.drain_events(
+            |t| tracing::info!(from = %t.from, to = %t.to, cause = %t.cause, at_us = t.at_us, "state change"),
+            |e| match e {
+                FingerEvent::Disabled(f) => tracing::warn!(finger = FINGER_NAMES[f], "finger controller silent: finger disabled"),
+                FingerEvent::Enabled(f) => tracing::info!(finger = FINGER_NAMES[f], "finger controller back: finger enabled"),
+            },
+        );
+        self.publish();
+        self.next_deadline_us += self.tick_us;
+        // After a long stall, skip the missed ticks rather than run them back to back.
+        if self.next_deadline_us + self.tick_us < t1 {
+            let behind = (t1 - self.next_deadline_us) / self.tick_us;
+            self.next_deadline_us += behind * self.tick_us;
+        }
+    }
+
+    fn publish(&self) {
+        let e = &self.engine;
+        let snap = Snapshot {
+            state: e.state(),
+            faults: e.faults(),
+            counters: e.counters(),
+            latency: e.latency().summary(),
+            compute: e.compute().summary(),
+            labels: *e.labels(),
+            setpoints: *e.setpoints(),
+            reported_force: *e.reported_force(),
+            disabled: std::array::from_fn(|f| e.finger_disabled(f)),
+            gains: *e.gains(),
+            bus_ok: self.bus_ok,
+        };
+        if let Ok(mut s) = self.snapshot.try_lock() {
+            *s = snap;
+        }
+    }
+
+    /// Run on the system clock until `stop` is set, sleeping to each absolute deadline; calls
+    /// `on_tick` after every tick (the daemon feeds the systemd watchdog there).
+    pub fn run_realtime(&mut self, stop: &AtomicBool, mut on_tick: impl FnMut(&Self)) {
+        while !stop.load(Ordering::Relaxed) {
+            let now = self.clock.now_us();
+            if self.next_deadline_us > now {
+                std::thread::sleep(std::time::Duration::from_micros(
+                    self.next_deadline_us - now,
+                ));
+            }
+            self.step();
+            on_tick(self);
+        }
+    }
+}

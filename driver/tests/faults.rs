@@ -1,0 +1,248 @@
+//! Every fault of the simulated world's list, on a virtual clock: the time from its onset to
+//! safe-stop setpoints on the bus (or the one finger's disable), and the recovery rule.
+
+mod common;
+
+use common::Rig;
+use driver::engine::Command;
+use driver::safety::{DaemonState, Fault as DFault};
+use hand_dbc::messages::FingerMode;
+use hand_model::faults::{CrcTarget, Fault, FaultPlan};
+use hand_model::patient::Script;
+
+const ONSET: u64 = 2_000_000;
+const TICK: u64 = 50_000;
+
+fn rig(fault: Fault, until: u64) -> Rig {
+    let mut plan = FaultPlan::new();
+    plan.add(fault, ONSET, until).unwrap();
+    Rig::new(plan, Script::resting(20_000_000))
+}
+
+/// Runs to the onset, checks the hand was running, runs `after` more, and returns the time from
+/// onset to stop of all fingers (or `finger`).
+fn time_to_stop(rig: &mut Rig, after: u64, finger: Option<usize>) -> u64 {
+    rig.run_until(ONSET - 1000);
+    assert_eq!(
+        rig.runner.engine().state(),
+        DaemonState::Running,
+        "running before the fault: {} {:?}",
+        rig.runner.engine().faults(),
+        rig.runner.engine().counters()
+    );
+    let before: Vec<_> = rig
+        .setpoints()
+        .into_iter()
+        .filter(|s| s.0 > ONSET - 200_000)
+        .collect();
+    assert!(
+        before.iter().all(|s| s.2 == FingerMode::Active),
+        "all fingers active before the fault"
+    );
+    rig.run_until(ONSET + after);
+    let t = rig
+        .stopped_from(ONSET, ONSET + after, finger)
+        .expect("the hand stopped after the fault");
+    let dt = t.saturating_sub(ONSET);
+    println!("time to stop: {} ms", dt as f64 / 1000.0);
+    dt
+}
+
+#[test]
+fn amplifier_silence_stops_within_100ms_and_recovers_by_itself() {
+    let mut r = rig(Fault::AmplifierSilence, ONSET + 300_000);
+    let dt = time_to_stop(&mut r, 250_000, None);
+    assert!(dt <= 100_000, "{dt} us");
+    assert!(
+        r.runner.engine().faults().contains(DFault::EmgSilence)
+            || r.runner.engine().faults().contains(DFault::InvalidWindow)
+    );
+    // Signal back at +300 ms; the window refills (200 ms) and must stay good for 500 ms.
+    r.run_until(ONSET + 300_000 + 600_000);
+    assert_eq!(
+        r.runner.engine().state(),
+        DaemonState::Safe,
+        "not before 500 ms of good signal"
+    );
+    r.run_until(ONSET + 300_000 + 1_200_000);
+    assert_eq!(
+        r.runner.engine().state(),
+        DaemonState::Running,
+        "transient fault clears by itself"
+    );
+}
+
+#[test]
+fn corrupted_emg_crc_stops_within_100ms() {
+    let mut r = rig(
+        Fault::BadCrc {
+            target: CrcTarget::Emg,
+            every: 1,
+        },
+        ONSET + 300_000,
+    );
+    let dt = time_to_stop(&mut r, 250_000, None);
+    assert!(dt <= 100_000, "{dt} us");
+    // That many errors latch: no recovery without arm.
+    r.run_until(ONSET + 2_000_000);
+    assert_eq!(r.runner.engine().state(), DaemonState::Safe);
+    assert!(r.runner.engine().faults().contains(DFault::RepeatedE2e));
+    let now = r.clock_now();
+    r.runner.engine_mut().command(now, Command::Arm).unwrap();
+    r.run_until(ONSET + 2_700_000);
+    assert_eq!(
+        r.runner.engine().state(),
+        DaemonState::Running,
+        "armed, good signal: running"
+    );
+}
+
+#[test]
+fn counter_jump_stops_within_100ms_and_recovers() {
+    let mut r = rig(Fault::CounterJump { by: 40 }, ONSET + 1_000);
+    let dt = time_to_stop(&mut r, 200_000, None);
+    assert!(dt <= 100_000, "{dt} us");
+    r.run_until(ONSET + 1_200_000);
+    assert_eq!(
+        r.runner.engine().state(),
+        DaemonState::Running,
+        "a gap is transient"
+    );
+}
+
+#[test]
+fn estop_stops_within_100ms_and_latches() {
+    let mut r = rig(Fault::EStop, ONSET + 100_000);
+    let dt = time_to_stop(&mut r, 200_000, None);
+    assert!(dt <= 100_000, "{dt} us");
+    r.run_until(ONSET + 3_000_000);
+    assert_eq!(
+        r.runner.engine().state(),
+        DaemonState::Safe,
+        "E-stop latches"
+    );
+    let now = r.clock_now();
+    r.runner.engine_mut().command(now, Command::Arm).unwrap();
+    r.run_until(ONSET + 3_600_000);
+    assert_eq!(r.runner.engine().state(), DaemonState::Running);
+}
+
+#[test]
+fn silent_finger_controller_disables_that_finger_alone() {
+    let mut r = rig(Fault::MotorSilent { finger: 2 }, ONSET + 500_000);
+    let dt = time_to_stop(&mut r, 300_000, Some(2));
+    // Disabling needs 100 ms of silence by definition, then the next tick sends it.
+    assert!(dt <= 100_000 + TICK, "{dt} us");
+    let after: Vec<_> = r
+        .setpoints()
+        .into_iter()
+        .filter(|s| s.0 > ONSET + 200_000 && s.0 < ONSET + 300_000)
+        .collect();
+    assert!(after
+        .iter()
+        .filter(|s| s.1 == 2)
+        .all(|s| s.2 == FingerMode::Disabled));
+    assert!(
+        after
+            .iter()
+            .filter(|s| s.1 != 2)
+            .all(|s| s.2 == FingerMode::Active),
+        "others go on"
+    );
+    r.run_until(ONSET + 1_200_000);
+    assert!(
+        !r.runner.engine().finger_disabled(2),
+        "back after reporting again for 500 ms"
+    );
+}
+
+#[test]
+fn lead_off_and_saturation_stop_within_100ms() {
+    for fault in [
+        Fault::LeadOff { channels: 0b100 },
+        Fault::Saturation { channels: 0b1 },
+    ] {
+        let mut r = rig(fault, ONSET + 300_000);
+        let dt = time_to_stop(&mut r, 250_000, None);
+        assert!(dt <= 100_000, "{fault:?}: {dt} us");
+        assert!(
+            r.runner.engine().faults().contains(DFault::SignalQuality),
+            "{fault:?}"
+        );
+        r.run_until(ONSET + 1_500_000);
+        assert_eq!(
+            r.runner.engine().state(),
+            DaemonState::Running,
+            "{fault:?} is transient"
+        );
+    }
+}
+
+#[test]
+fn tolerated_faults_keep_the_hand_running_and_are_counted() {
+    for fault in [
+        Fault::DropEmgFrames { every: 50 },
+        Fault::RepeatEmgFrames { every: 7 },
+        Fault::ReorderEmgFrames { every: 5 },
+        Fault::UnknownIdBurst {
+            id: 0x555,
+            count: 2000,
+        },
+        Fault::BusFlood,
+    ] {
+        let mut r = rig(fault, ONSET + 500_000);
+        r.run_until(ONSET + 800_000);
+        let e = r.runner.engine();
+        assert_eq!(e.state(), DaemonState::Running, "{fault:?}: {}", e.faults());
+        let c = e.counters();
+        match fault {
+            Fault::DropEmgFrames { .. } => assert!(c.samples_lost > 0, "{c:?}"),
+            Fault::UnknownIdBurst { count, .. } => {
+                assert!(c.bad_frames >= u64::from(count), "{c:?}")
+            }
+            Fault::BusFlood => assert!(c.bad_frames > 1000, "{c:?}"),
+            _ => {}
+        }
+        assert_eq!(c.deadline_misses, 0);
+    }
+}
+
+#[test]
+fn bus_off_stops_sending_drops_stale_setpoints_and_comes_back_safe() {
+    let mut r = Rig::new(FaultPlan::new(), Script::resting(20_000_000));
+    r.run_until(ONSET);
+    assert_eq!(r.runner.engine().state(), DaemonState::Running);
+    r.bus.set_bus_off(true);
+    r.run_until(ONSET + 500_000);
+    assert!(r.runner.engine().faults().contains(DFault::BusOff));
+    let n_before = r.seen.len();
+    r.bus.set_bus_off(false);
+    r.run_until(ONSET + 1_500_000);
+    let after = r
+        .setpoints()
+        .into_iter()
+        .filter(|s| s.0 > ONSET + 500_000)
+        .collect::<Vec<_>>();
+    assert!(
+        r.seen.len() > n_before,
+        "sending resumed after the bus came back"
+    );
+    assert!(!after.is_empty());
+    // Fingers whose status frames went unread while the bus was off come back DISABLED:
+    // zero force and velocity either way, never a stale ACTIVE setpoint.
+    assert!(
+        after.iter().all(
+            |s| matches!(s.2, FingerMode::SafeStop | FingerMode::Disabled)
+                && s.3 == 0.0
+                && s.4 == 0.0
+        ),
+        "back in SAFE, nothing stale: {:?}",
+        after
+            .iter()
+            .find(|s| !matches!(s.2, FingerMode::SafeStop | FingerMode::Disabled))
+    );
+    let now = r.clock_now();
+    r.runner.engine_mut().command(now, Command::Arm).unwrap();
+    r.run_until(ONSET + 2_200_000);
+    assert_eq!(r.runner.engine().state(), DaemonState::Running);
+}
