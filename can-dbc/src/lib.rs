@@ -11,6 +11,29 @@
 //!
 //! Nothing here knows sockets, threads or clocks: the same code runs in the daemon, the
 //! simulator, offline evaluation and replay.
+//!
+//! ```
+//! use hand_dbc::e2e::{E2eChecker, E2eProtector, E2eStatus};
+//! use hand_dbc::messages::{self, FingerMode, FingerSetpoint, Message};
+//!
+//! // Sender: a checked setpoint for finger 1 (index), protected with counter and CRC.
+//! let sp = FingerSetpoint::new(1, FingerMode::Active, 4.5, -0.25)?;
+//! let mut protector = E2eProtector::new(sp.e2e());
+//! let frame = protector.protect_message(&sp)?;
+//! assert_eq!(frame.raw_id(), 0x201);
+//!
+//! // Out-of-range values are refused, never wrapped or saturated.
+//! assert!(FingerSetpoint::new(1, FingerMode::Active, 80.0, 0.0).is_err());
+//!
+//! // Receiver: check E2E, then decode by id.
+//! let mut checker = E2eChecker::try_new(FingerSetpoint::E2E[1], 1)?;
+//! assert_eq!(checker.check_frame(Some(&frame)), E2eStatus::Ok);
+//! match messages::decode_frame(&frame)? {
+//!     Message::FingerSetpoint(m) => assert_eq!((m.instance(), m.force()), (1, 4.5)),
+//!     other => panic!("unexpected {other:?}"),
+//! }
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 pub mod busload;
 pub mod candump;

@@ -145,3 +145,20 @@ fn diag_labels_are_checked_and_protected_messages_carry_valid_crc() {
     let mut other = E2eChecker::try_new(FingerSetpoint::E2E[3], 1).expect("valid config");
     assert_eq!(other.check_frame(Some(&frame)), E2eStatus::Error);
 }
+
+#[test]
+fn physical_values_round_to_the_nearest_step_within_the_range() {
+    let mut sp = FingerSetpoint::new(0, FingerMode::Active, 0.0, 0.0).expect("valid");
+    sp.set_force(12.344).expect("in range");
+    assert_eq!(sp.force_raw(), 1234);
+    sp.set_force(-12.346).expect("in range");
+    assert_eq!(sp.force_raw(), -1235);
+    let mut st = FingerStatus::new(3, hand_dbc::messages::FingerState::Hold, -0.5, 0.0, 0.0, 0)
+        .expect("valid");
+    assert_eq!(st.position_raw(), 0, "offset -0.5 rad maps to raw 0");
+    st.set_position(2.0).expect("upper limit");
+    assert_eq!(st.position_raw(), 2500);
+    assert!(st.set_position(2.01).is_err());
+    assert!(st.set_position(-0.51).is_err());
+    assert_eq!(st.id(), 0x283);
+}
