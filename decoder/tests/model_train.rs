@@ -342,3 +342,34 @@ fn masked_fingers_do_not_influence_training() {
     .expect("trains");
     assert_eq!(a.model().params(), b.model().params());
 }
+
+#[test]
+fn names_parse() {
+    use std::str::FromStr;
+    assert_eq!(ModelKind::from_str(" ResDD ").unwrap(), ModelKind::ResDd);
+    for k in ModelKind::ALL {
+        assert_eq!(k.name().parse::<ModelKind>().unwrap(), k);
+        assert_eq!(k.to_string(), k.name());
+    }
+    let e = "transformer".parse::<ModelKind>().unwrap_err();
+    assert!(e.to_string().contains("resdd, ln, mlp, cnn"), "{e}");
+    assert_eq!("sgd".parse::<Optimizer>().unwrap(), Optimizer::sgd());
+    assert_eq!("Adam".parse::<Optimizer>().unwrap(), Optimizer::adam());
+    assert!("rmsprop".parse::<Optimizer>().is_err());
+    assert_eq!(
+        "trial-tail".parse::<ValidationSplit>().unwrap(),
+        ValidationSplit::TrialTail { fraction: 0.2 }
+    );
+    assert_eq!(
+        "none".parse::<ValidationSplit>().unwrap(),
+        ValidationSplit::None
+    );
+    assert_eq!(
+        "window".parse::<ValidationSplit>().unwrap(),
+        ValidationSplit::Window { fraction: 0.2 }
+    );
+    assert!(matches!(
+        "by-magic".parse::<ValidationSplit>().unwrap_err(),
+        TrainError::Config(ref m) if m.contains("trial-tail")
+    ));
+}

@@ -1,5 +1,7 @@
 //! Training settings: optimizer, batching, early stopping, validation split, seed.
 
+use std::str::FromStr;
+
 use serde::{Deserialize, Serialize};
 
 use super::error::TrainError;
@@ -91,6 +93,21 @@ impl Default for Optimizer {
     }
 }
 
+impl FromStr for Optimizer {
+    type Err = TrainError;
+
+    /// "adam" or "sgd", with their default settings.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "adam" => Ok(Optimizer::adam()),
+            "sgd" => Ok(Optimizer::sgd()),
+            _ => Err(TrainError::Config(format!(
+                "unknown optimizer {s:?}: expected adam or sgd"
+            ))),
+        }
+    }
+}
+
 /// How the windows used for early stopping are held out.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "by", rename_all = "snake_case")]
@@ -124,6 +141,24 @@ pub enum ValidationSplit {
 impl Default for ValidationSplit {
     fn default() -> Self {
         ValidationSplit::Trial { fraction: 0.2 }
+    }
+}
+
+impl FromStr for ValidationSplit {
+    type Err = TrainError;
+
+    /// "trial", "trial-tail" or "window" (each holding out 20%), or "none".
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let fraction = 0.2;
+        match s.trim().to_ascii_lowercase().as_str() {
+            "trial" => Ok(ValidationSplit::Trial { fraction }),
+            "trial-tail" | "trial_tail" => Ok(ValidationSplit::TrialTail { fraction }),
+            "window" => Ok(ValidationSplit::Window { fraction }),
+            "none" => Ok(ValidationSplit::None),
+            _ => Err(TrainError::Config(format!(
+                "unknown validation split {s:?}: expected trial, trial-tail, window or none"
+            ))),
+        }
     }
 }
 
