@@ -181,3 +181,28 @@ fn batch_refuses_a_ragged_buffer() {
     let empty = batch_features(&s, &[]);
     assert_eq!((empty.n_rows, empty.n_cols, empty.data.len()), (0, 24, 0));
 }
+
+#[test]
+fn a_silent_channel_settles_to_exact_zero_not_subnormals() {
+    // After an impulse, zero input makes IIR state decay into subnormals and cycle there
+    // forever unless it is flushed; the chain flushes state below FLUSH_BELOW.
+    let s = settings(2);
+    let mut chain = Chain::new(&s);
+    chain.push(&[1000.0, -3.0e4]);
+    let mut smallest_nonzero = f64::MAX;
+    for _ in 0..200_000 {
+        chain.push(&[0.0, 0.0]);
+        for &v in chain.last_filtered().iter().chain(chain.features()) {
+            if v != 0.0 {
+                smallest_nonzero = smallest_nonzero.min(v.abs());
+            }
+        }
+    }
+    assert!(
+        smallest_nonzero >= f64::MIN_POSITIVE,
+        "a subnormal value appeared: {smallest_nonzero:e}"
+    );
+    assert!(chain.last_filtered().iter().all(|&v| v == 0.0));
+    assert!(chain.features().iter().all(|&v| v == 0.0));
+    assert!(decoder::dsp::FLUSH_BELOW > 0.0);
+}

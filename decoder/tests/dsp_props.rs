@@ -120,6 +120,45 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 32, ..ProptestConfig::default() })]
+
+    /// Any f64 at all (NaN, infinities, f64::MAX, subnormals) never makes a feature non-finite,
+    /// and every bad value is counted on its channel.
+    #[test]
+    fn any_input_keeps_features_finite(values in prop::collection::vec(prop::num::f64::ANY, 3 * 420)) {
+        let s = settings(3, 50, FeatureSignal::Rectified);
+        let mut chain = Chain::new(&s);
+        let mut bad = [0u64; 3];
+        for sample in values.chunks_exact(3) {
+            for (c, v) in sample.iter().enumerate() {
+                if !(v.abs() <= decoder::dsp::MAX_ABS_SAMPLE) {
+                    bad[c] += 1;
+                }
+            }
+            chain.push(sample);
+            prop_assert!(chain.features().iter().all(|f| f.is_finite()));
+            prop_assert!(chain.last_filtered().iter().all(|f| f.is_finite()));
+        }
+        for (c, &n) in bad.iter().enumerate() {
+            prop_assert_eq!(chain.faults().bad_samples(c), n);
+        }
+        prop_assert_eq!(chain.vectors_emitted(), 5);
+    }
+
+    /// Large but accepted values (up to MAX_ABS_SAMPLE) keep everything finite as well.
+    #[test]
+    fn extreme_finite_input_keeps_features_finite(values in prop::collection::vec(-1e12f64..1e12, 2 * 400)) {
+        let s = settings(2, 60, FeatureSignal::Filtered);
+        let mut chain = Chain::new(&s);
+        for sample in values.chunks_exact(2) {
+            chain.push(sample);
+        }
+        prop_assert!(chain.features().iter().all(|f| f.is_finite()));
+        prop_assert_eq!(chain.faults().total(), 0);
+    }
+}
+
 #[test]
 fn the_notch_leaves_other_frequencies_alone() {
     // A narrow notch: 100 Hz and 30 Hz pass within 0.5 dB at Q = 30 (the band-pass is flat there).

@@ -4,6 +4,15 @@ use super::config::{ChainSettings, FeatureSignal};
 use super::faults::{Faults, MAX_ABS_SAMPLE};
 use super::features::{features_into, FEATURES_PER_CHANNEL};
 
+/// Filter state smaller than this is set to exactly 0 (every [`FLUSH_EVERY`] samples). Without
+/// it a silent channel's IIR state decays into subnormal numbers and stays there in a limit
+/// cycle, which makes every later operation on it slow (2x on this machine, far worse on some
+/// CPUs). 1e-150 keeps squares in the features normal too; the change to the output is below
+/// 1e-150 in absolute terms.
+pub const FLUSH_BELOW: f64 = 1e-150;
+/// How often (in samples) tiny filter state is flushed; a power of two.
+const FLUSH_EVERY: u64 = 64;
+
 /// The streaming signal chain for all channels (see the module docs for the stages).
 ///
 /// Built once from [`ChainSettings`] (all memory is allocated then), fed one multi-channel
@@ -130,6 +139,13 @@ impl Chain {
                 *z0 = b1 * xin - a1 * y + *z1;
                 *z1 = b2 * xin - a2 * y;
                 *x = y;
+            }
+        }
+        if self.count.is_multiple_of(FLUSH_EVERY) {
+            for z in self.z0.iter_mut().chain(self.z1.iter_mut()) {
+                if z.abs() < FLUSH_BELOW {
+                    *z = 0.0;
+                }
             }
         }
     }

@@ -279,6 +279,11 @@ pub struct ChainSettings {
 }
 
 impl ChainSettings {
+    /// Same as [`ChainConfig::validate`]: checks `config` and designs the filters.
+    pub fn try_new(config: &ChainConfig) -> Result<ChainSettings, ConfigError> {
+        config.validate()
+    }
+
     /// The configuration these settings were validated from.
     pub fn config(&self) -> &ChainConfig {
         &self.inner.config

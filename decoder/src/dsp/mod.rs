@@ -18,7 +18,9 @@
 //! 4. **Full-wave rectification** `|y|` (switchable off with [`FeatureSignal::Filtered`]).
 //!
 //! Every section runs in transposed direct form II with the same operation order as scipy's
-//! `sosfilt`, so the filtered output equals `sosfilt` of the same sections to rounding.
+//! `sosfilt`, so the filtered output equals `sosfilt` of the same sections to rounding. One
+//! deliberate difference: every 64 samples, filter state below [`FLUSH_BELOW`] (1e-150) is set
+//! to 0, so a silent channel never sinks into slow subnormal arithmetic.
 //!
 //! The last `window_len` processed values of each channel are kept in a ring buffer; every
 //! `step_len` samples (once the first window is full) the 8 features of the paper's Table 1 are
@@ -55,7 +57,7 @@ pub mod npy;
 mod sos;
 
 pub use batch::{batch_features, batch_filtered, try_batch_features, BatchError, FeatureMatrix};
-pub use chain::Chain;
+pub use chain::{Chain, FLUSH_BELOW};
 pub use config::{
     ChainConfig, ChainSettings, ConfigError, FeatureSignal, MAX_CHANNELS, MAX_ORDER, Q_RANGE,
 };
