@@ -179,6 +179,20 @@ fn load_rejects_each_defect_with_a_named_error() {
         matches!(e, FileError::WrongShape { ref tensor, .. } if tensor == "w_mod.3"),
         "{e}"
     );
+    // A corrupt spec asking for a huge model is refused from the shapes alone (no allocation
+    // of the claimed 1e9 parameters happens before the check).
+    let mut p = split(&good);
+    p.meta["spec"]["resdd"]["hidden"] = serde_json::json!(4096);
+    p.meta["spec"]["resdd"]["modules"] = serde_json::json!(64);
+    let e = load(&join(&p));
+    assert!(
+        matches!(e, FileError::WrongShape { ref tensor, .. } if tensor == "w_in"),
+        "{e}"
+    );
+    let mut p = split(&good);
+    p.meta["spec"]["resdd"]["hidden"] = serde_json::json!(0);
+    let e = load(&join(&p));
+    assert!(e.to_string().contains("hidden width"), "{e}");
     // Normalizer of the wrong length.
     let mut p = split(&good);
     p.meta["normalizer"]["shape"] = serde_json::json!([15]);

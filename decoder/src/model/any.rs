@@ -81,14 +81,13 @@ impl AnyModel {
         n_in: usize,
         n_out: usize,
     ) -> Result<Vec<TensorInfo>, ModelError> {
-        let n = match kind {
-            ModelKind::ResDd => ResDd::param_count(&spec.resdd, n_in, n_out),
-            ModelKind::Ln => DenseNet::param_count(kind, n_in, spec.ln.hidden, n_out),
-            ModelKind::Mlp => DenseNet::param_count(kind, n_in, spec.mlp.hidden, n_out),
-            ModelKind::Cnn => Cnn::param_count(&spec.cnn, n_in, n_out)?,
-        };
-        // Zero parameters have the right layout; the constructor validates the spec.
-        Ok(Self::from_params(kind, spec, n_in, n_out, vec![0.0; n])?.tensors())
+        // Computed from the shapes alone: a corrupt file claiming huge widths costs nothing here.
+        match kind {
+            ModelKind::ResDd => ResDd::layout(&spec.resdd, n_in, n_out),
+            ModelKind::Ln => DenseNet::layout(kind, n_in, spec.ln.hidden, n_out),
+            ModelKind::Mlp => DenseNet::layout(kind, n_in, spec.mlp.hidden, n_out),
+            ModelKind::Cnn => Cnn::layout(&spec.cnn, n_in, n_out),
+        }
     }
 
     fn inner(&self) -> &dyn Trainable {

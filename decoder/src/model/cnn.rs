@@ -15,7 +15,7 @@ use super::init::SeededRng;
 use super::kind::ModelKind;
 use super::linalg::{axpy, dot, matvec_bias, matvec_t, outer_acc, relu, relu_backward};
 use super::spec::{check_width, CnnSpec};
-use super::traits::{check_io, Model, Scratch, TensorInfo, Trainable};
+use super::traits::{check_io, stacked, Model, Scratch, TensorInfo, Trainable};
 
 /// The CNN baseline (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -234,6 +234,28 @@ impl Cnn {
         })
     }
 
+    /// The tensors of a CNN of this shape, without building one. Errors on an invalid spec.
+    pub fn layout(
+        spec: &CnnSpec,
+        n_in: usize,
+        n_out: usize,
+    ) -> Result<Vec<TensorInfo>, ModelError> {
+        let dm = Self::dims(spec, n_in, n_out)?;
+        let named = [
+            ("conv1.weight", vec![dm.f1, dm.k, dm.cin]),
+            ("conv1.bias", vec![dm.f1]),
+            ("conv2.weight", vec![dm.f2, dm.k, dm.f1]),
+            ("conv2.bias", vec![dm.f2]),
+            ("dense1.weight", vec![dm.d, dm.p2 * dm.f2]),
+            ("dense1.bias", vec![dm.d]),
+            ("dense2.weight", vec![dm.n_out, dm.d]),
+            ("dense2.bias", vec![dm.n_out]),
+        ];
+        Ok(stacked(
+            named.into_iter().map(|(n, s)| (n.to_string(), s)).collect(),
+        ))
+    }
+
     /// The hyper-parameters.
     pub fn spec(&self) -> &CnnSpec {
         &self.spec
@@ -308,30 +330,7 @@ impl Trainable for Cnn {
     }
 
     fn tensors(&self) -> Vec<TensorInfo> {
-        let dm = self.d();
-        let shapes: [(&str, Vec<usize>); 8] = [
-            ("conv1.weight", vec![dm.f1, dm.k, dm.cin]),
-            ("conv1.bias", vec![dm.f1]),
-            ("conv2.weight", vec![dm.f2, dm.k, dm.f1]),
-            ("conv2.bias", vec![dm.f2]),
-            ("dense1.weight", vec![dm.d, dm.p2 * dm.f2]),
-            ("dense1.bias", vec![dm.d]),
-            ("dense2.weight", vec![dm.n_out, dm.d]),
-            ("dense2.bias", vec![dm.n_out]),
-        ];
-        let mut off = 0;
-        shapes
-            .into_iter()
-            .map(|(name, shape)| {
-                let t = TensorInfo {
-                    name: name.into(),
-                    shape,
-                    offset: off,
-                };
-                off += t.len();
-                t
-            })
-            .collect()
+        Self::layout(&self.spec, self.n_in, self.n_out).expect("validated at construction")
     }
 
     fn backward(&self, x: &[f64], dy: &[f64], scratch: &mut Scratch, grad: &mut [f64]) {

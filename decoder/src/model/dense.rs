@@ -13,7 +13,7 @@ use super::init::SeededRng;
 use super::kind::ModelKind;
 use super::linalg::{axpy, matvec, matvec_bias, matvec_t, outer_acc, relu, relu_backward};
 use super::spec::{check_width, LnSpec, MlpSpec};
-use super::traits::{check_io, Model, Scratch, TensorInfo, Trainable};
+use super::traits::{check_io, stacked, Model, Scratch, TensorInfo, Trainable};
 
 /// LN or MLP (see the module docs); `kind()` says which.
 #[derive(Debug, Clone, PartialEq)]
@@ -63,6 +63,28 @@ impl DenseNet {
         check_width("first hidden width", hidden[0])?;
         check_width("second hidden width", hidden[1])?;
         check_width("output size", n_out)
+    }
+
+    /// The tensors of an LN (`w1..w3`) or MLP (`w1, b1.bias, .., b3.bias`) of this shape,
+    /// without building one. Errors on an invalid shape.
+    pub fn layout(
+        kind: ModelKind,
+        n_in: usize,
+        hidden: [usize; 2],
+        n_out: usize,
+    ) -> Result<Vec<TensorInfo>, ModelError> {
+        Self::check(kind, n_in, hidden, n_out)?;
+        let mut named = Vec::new();
+        for (j, (r, c)) in Self::layer_shapes(n_in, hidden, n_out)
+            .into_iter()
+            .enumerate()
+        {
+            named.push((format!("w{}", j + 1), vec![r, c]));
+            if Self::is_mlp(kind) {
+                named.push((format!("b{}.bias", j + 1), vec![r]));
+            }
+        }
+        Ok(stacked(named))
     }
 
     /// An LN model from its parameters `[W1, W2, W3]` (row-major).
@@ -248,28 +270,8 @@ impl Trainable for DenseNet {
     }
 
     fn tensors(&self) -> Vec<TensorInfo> {
-        let mut v = Vec::new();
-        let mut off = 0;
-        for (j, (r, c)) in Self::layer_shapes(self.n_in, self.hidden, self.n_out)
-            .into_iter()
-            .enumerate()
-        {
-            v.push(TensorInfo {
-                name: format!("w{}", j + 1),
-                shape: vec![r, c],
-                offset: off,
-            });
-            off += r * c;
-            if self.has_bias() {
-                v.push(TensorInfo {
-                    name: format!("b{}.bias", j + 1),
-                    shape: vec![r],
-                    offset: off,
-                });
-                off += r;
-            }
-        }
-        v
+        Self::layout(self.kind, self.n_in, self.hidden, self.n_out)
+            .expect("validated at construction")
     }
 
     fn backward(&self, x: &[f64], dy: &[f64], scratch: &mut Scratch, grad: &mut [f64]) {

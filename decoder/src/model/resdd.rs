@@ -11,7 +11,7 @@ use super::init::SeededRng;
 use super::kind::ModelKind;
 use super::linalg::{matvec, matvec_t, outer_acc};
 use super::spec::{check_width, ResDdSpec, ResDdVariant, MAX_MODULES};
-use super::traits::{check_io, Model, Scratch, TensorInfo, Trainable};
+use super::traits::{check_io, stacked, Model, Scratch, TensorInfo, Trainable};
 
 /// Gain of `W_in`'s Glorot initialisation: with unit-RMS inputs `X` has RMS about 0.25, so the
 /// quadratic term `G∘X` starts at about a quarter of the linear term `G`.
@@ -111,6 +111,21 @@ impl ResDd {
         })
     }
 
+    /// The tensors of a ResDD of this shape (`w_in`, `w_mod.1`..`w_mod.L`, `w_out`), without
+    /// building one. Errors on an invalid spec.
+    pub fn layout(
+        spec: &ResDdSpec,
+        n_in: usize,
+        n_out: usize,
+    ) -> Result<Vec<TensorInfo>, ModelError> {
+        Self::check(spec, n_in, n_out)?;
+        let h = spec.hidden;
+        let mut named = vec![("w_in".to_string(), vec![h, n_in])];
+        named.extend((1..=spec.modules).map(|l| (format!("w_mod.{l}"), vec![h, h])));
+        named.push(("w_out".to_string(), vec![n_out, h]));
+        Ok(stacked(named))
+    }
+
     /// The hyper-parameters.
     pub fn spec(&self) -> &ResDdSpec {
         &self.spec
@@ -199,25 +214,7 @@ impl Trainable for ResDd {
     }
 
     fn tensors(&self) -> Vec<TensorInfo> {
-        let h = self.spec.hidden;
-        let mut v = vec![TensorInfo {
-            name: "w_in".into(),
-            shape: vec![h, self.n_in],
-            offset: 0,
-        }];
-        for l in 0..self.spec.modules {
-            v.push(TensorInfo {
-                name: format!("w_mod.{}", l + 1),
-                shape: vec![h, h],
-                offset: h * self.n_in + l * h * h,
-            });
-        }
-        v.push(TensorInfo {
-            name: "w_out".into(),
-            shape: vec![self.n_out, h],
-            offset: h * self.n_in + self.spec.modules * h * h,
-        });
-        v
+        Self::layout(&self.spec, self.n_in, self.n_out).expect("validated at construction")
     }
 
     fn backward(&self, x: &[f64], dy: &[f64], scratch: &mut Scratch, grad: &mut [f64]) {

@@ -58,6 +58,23 @@ impl TensorInfo {
     }
 }
 
+/// Offsets for tensors stored back to back in the given order.
+pub(crate) fn stacked(named: Vec<(String, Vec<usize>)>) -> Vec<TensorInfo> {
+    let mut offset = 0;
+    named
+        .into_iter()
+        .map(|(name, shape)| {
+            let t = TensorInfo {
+                name,
+                shape,
+                offset,
+            };
+            offset += t.len();
+            t
+        })
+        .collect()
+}
+
 /// A feature-to-label model with fixed input and output sizes.
 ///
 /// `predict_with` is the daemon's path: no allocation, no `Result`; it panics only if `x`, `y`
