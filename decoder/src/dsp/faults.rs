@@ -10,6 +10,10 @@ pub const MAX_ABS_SAMPLE: f64 = 1e12;
 /// A bad sample (NaN, infinite, or beyond [`MAX_ABS_SAMPLE`]) is counted here, resets that
 /// channel's filter state and enters the filter as 0. The features stay finite throughout;
 /// [`Faults::in_window`] tells whether the current window of a channel still contains one.
+///
+/// Known limit: the filters restart from rest, so on a channel with a large DC offset the
+/// restart is a step that the 1 Hz DC high-pass takes about a second to forget, longer than
+/// the window flag lasts. Upstream, lost samples are better bridged (held) than sent as NaN.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Faults {
     non_finite: Vec<u64>,
