@@ -9,6 +9,7 @@ pub mod engine;
 pub mod protocol;
 pub mod rt;
 pub mod safety;
+pub mod socketcan_bus;
 pub mod stats;
 pub mod transport;
 pub mod tuning;

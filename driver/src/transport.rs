@@ -1,8 +1,11 @@
 //! How the daemon reaches the bus. The control logic ([`crate::engine`]) sees frames and
 //! times only; a [`Transport`] delivers received frames with their receive time and sends
-//! frames, and reports the bus's health as errors. Backends: any `embedded_can::nb::Can`
-//! (timestamped with the daemon's clock when read), the in-memory bus of `hand-model` (with
-//! its own receive times), and SocketCAN ([`crate::socketcan_bus`], kernel timestamps).
+//! frames, and reports the bus's health as errors. Backends: the in-memory bus of `hand-model`
+//! (with its own per-frame receive times) and SocketCAN ([`crate::socketcan_bus`], kernel
+//! receive timestamps).
+//!
+//! Receive times must be each frame's own: a transport that stamped a whole batch with the
+//! time it was read would make the EMG reassembler see 50 ms gaps between batches.
 
 use hand_dbc::CanFrame;
 use hand_model::{Clock, MemBusError, MemEndpoint};
@@ -75,52 +78,4 @@ impl<K: Clock> Transport for MemTransport<K> {
     fn reopen(&mut self) -> Result<(), TransportError> {
         Ok(())
     }
-}
-
-/// Any `embedded_can::nb::Can` whose frames are [`CanFrame`]s; frames are timestamped with
-/// `clock` when read, so latency figures include the time they waited in the queue.
-pub struct NbTransport<C, K> {
-    can: C,
-    clock: K,
-}
-
-impl<C, K> NbTransport<C, K> {
-    /// Wraps a driver.
-    pub fn new(can: C, clock: K) -> Self {
-        Self { can, clock }
-    }
-}
-
-impl<C, K> Transport for NbTransport<C, K>
-where
-    C: embedded_can::nb::Can<Frame = CanFrame>,
-    K: Clock,
-{
-    fn try_recv(&mut self) -> Result<Option<Timestamped>, TransportError> {
-        match self.can.receive() {
-            Ok(f) => Ok(Some((f, self.clock.now_us()))),
-            Err(nb::Error::WouldBlock) => Ok(None),
-            Err(nb::Error::Other(e)) => Err(map_kind(embedded_can::Error::kind(&e))),
-        }
-    }
-
-    fn send(&mut self, frame: &CanFrame) -> Result<(), TransportError> {
-        match self.can.transmit(frame) {
-            Ok(_) => Ok(()),
-            Err(nb::Error::WouldBlock) => Err(TransportError::Io(std::io::Error::from(
-                std::io::ErrorKind::WouldBlock,
-            ))),
-            Err(nb::Error::Other(e)) => Err(map_kind(embedded_can::Error::kind(&e))),
-        }
-    }
-
-    fn drop_queued(&mut self) {}
-
-    fn reopen(&mut self) -> Result<(), TransportError> {
-        Ok(())
-    }
-}
-
-fn map_kind(kind: embedded_can::ErrorKind) -> TransportError {
-    TransportError::Down(format!("{kind:?}"))
 }
