@@ -6,4 +6,6 @@
 //! offline evaluation, in replay and in the simulator, bit for bit.
 
 pub mod dsp;
+pub mod eval;
 pub mod model;
+pub mod session;

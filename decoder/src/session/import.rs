@@ -178,8 +178,10 @@ fn three_dc_meta(dir: &Path, split: Split) -> Result<(SessionMeta, PathBuf), Ses
 
 /// Reads the 3DC recordings of `split` directly as a session.
 pub fn load_3dc(dir: &Path, split: Split) -> Result<Session, SessionError> {
-    let (meta, _) = three_dc_meta(dir, split)?;
-    let recording = Recording::load(&meta, dir)?;
+    // Absolute, so the recording path in the metadata does not depend on the working directory.
+    let abs = std::fs::canonicalize(dir).map_err(|e| SessionError::io(dir, e))?;
+    let (meta, _) = three_dc_meta(&abs, split)?;
+    let recording = Recording::load(&meta, &abs)?;
     Session::from_parts(
         PathBuf::from(format!("3dc:{}:{}", dir.display(), split.name())),
         meta,

@@ -16,6 +16,11 @@ pub struct Recording {
     pub time_us: Vec<u64>,
     /// Samples the bus lost and the assembler bridged (0 for sample files).
     pub lost_samples: u64,
+    /// Sample indices that follow a gap too long to bridge (over 20 ms): no window may span
+    /// one, as the daemon would have marked it invalid.
+    pub breaks: Vec<usize>,
+    /// Frames dropped for a wrong CRC (0 for sample files).
+    pub bad_frames: u64,
 }
 
 impl Recording {
@@ -47,6 +52,8 @@ impl Recording {
             samples,
             time_us,
             lost_samples: 0,
+            breaks: Vec::new(),
+            bad_frames: 0,
         })
     }
 

@@ -111,6 +111,9 @@ impl Session {
                 else {
                     continue;
                 };
+                if self.recording.breaks.iter().any(|&b| b > begin && b < end) {
+                    continue;
+                }
                 let t = &self.meta.trials[*ti];
                 out.features.extend_from_slice(m.row(r));
                 out.labels.push(WindowLabel {

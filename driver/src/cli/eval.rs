@@ -1,0 +1,128 @@
+//! `handctl eval`: train every named model on one session, score all on held-out data, print
+//! the paper's tables and write the figures.
+
+use std::path::Path;
+
+use decoder::eval::{
+    direction_table, evaluate_model, interpolation_png, interpolation_table, roc_png,
+    InterpolationConfig, ModelEvaluation,
+};
+use decoder::session::{LabelledWindows, Session, WindowOptions};
+
+use super::args::EvalArgs;
+use super::error::CliError;
+use super::train::{describe, fit, gate};
+
+/// Train and test windows: a separate test session, or the held-out last repetitions.
+fn split(
+    a: &EvalArgs,
+    session: &Session,
+    opts: &WindowOptions,
+) -> Result<(LabelledWindows, LabelledWindows, String), CliError> {
+    let all = session.windows(opts)?;
+    match &a.test {
+        Some(spec) => {
+            let test = Session::open_spec(spec)?;
+            if test.meta.chain != session.meta.chain {
+                return Err(CliError::Usage(format!(
+                    "{spec}: its [chain] differs from the training session's; features would not be comparable"
+                )));
+            }
+            // Testing always includes rest (to measure rest drift) even for a two-point model.
+            let test_windows = test.windows(&WindowOptions { two_point: false })?;
+            Ok((
+                all,
+                test_windows,
+                format!("trained on {}, tested on {spec}", a.session),
+            ))
+        }
+        None => {
+            let held = session.holdout_last_repetition();
+            if !held.iter().any(|&h| h) {
+                return Err(CliError::Usage(format!(
+                    "{}: no trial kind has two repetitions to hold one out; pass --test SESSION",
+                    a.session
+                )));
+            }
+            let train = all.filter_trials(|t| !held[t]);
+            let test = session
+                .windows(&WindowOptions { two_point: false })?
+                .filter_trials(|t| held[t]);
+            Ok((
+                train,
+                test,
+                format!(
+                    "{}: trained on the first repetitions, tested on the last",
+                    a.session
+                ),
+            ))
+        }
+    }
+}
+
+/// `handctl eval`.
+pub fn run(a: &EvalArgs) -> Result<(), CliError> {
+    let session = Session::open_spec(&a.session)?;
+    gate(&session, &a.training)?;
+    let opts = WindowOptions {
+        two_point: a.training.two_point,
+    };
+    let (train_w, test_w, what) = split(a, &session, &opts)?;
+    let data = train_w.to_dataset(&session.meta.chain)?;
+    if let Some(dir) = &a.plots {
+        std::fs::create_dir_all(dir).map_err(|source| CliError::Io {
+            path: dir.display().to_string(),
+            source,
+        })?;
+    }
+    println!(
+        "{what}; {} training windows, {} test windows{}",
+        train_w.len(),
+        test_w.len(),
+        if a.training.two_point {
+            "; two-point calibration (no rest)"
+        } else {
+            ""
+        }
+    );
+    let icfg = InterpolationConfig::default();
+    let mut evals: Vec<ModelEvaluation> = Vec::new();
+    for &kind in &a.models {
+        let model = fit(kind, &data, &a.training)?;
+        println!("trained {}", describe(&model));
+        let e = evaluate_model(&model, &test_w, &icfg)?;
+        if let Some(dir) = &a.plots {
+            write_plots(dir, &e)?;
+        }
+        evals.push(e);
+    }
+    println!();
+    print!("{}", direction_table(&evals));
+    println!();
+    print!("{}", interpolation_table(&evals, icfg.tolerance));
+    if let Some(dir) = &a.plots {
+        println!("\nfigures in {}", dir.display());
+    }
+    Ok(())
+}
+
+fn write_plots(dir: &Path, e: &ModelEvaluation) -> Result<(), CliError> {
+    let name = e.kind.name();
+    let per_finger: Vec<_> = e
+        .direction
+        .iter()
+        .map(|d| d.as_ref().map(|d| (d.roc.as_slice(), d.auc)))
+        .collect();
+    roc_png(
+        &dir.join(format!("roc_{name}.png")),
+        &format!("{name}: direction ROC per finger"),
+        &per_finger,
+    )?;
+    interpolation_png(
+        &dir.join(format!("interpolation_{name}.png")),
+        &format!("{name}: output against effort k (dashed: ideal s·k; red: failed curves)"),
+        &e.levels,
+        &e.curves,
+    )?;
+    Ok(())
+}

@@ -1,0 +1,33 @@
+//! The `handctl` commands: one module per subcommand, the argument structures in `args`.
+
+mod args;
+mod error;
+mod eval;
+mod import;
+mod progress;
+mod train;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+use args::{Cli, Command};
+
+/// Parses the command line, runs the command, prints an error and returns the exit code
+/// (0 success, 1 failure, 2 usage error from clap, 3 quality gates refused the session).
+pub fn run() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Train(a) => train::run(a),
+        Command::Eval(a) => eval::run(a),
+        Command::Import3dc(a) => import::run_3dc(a),
+        Command::Check(a) => train::run_check(a),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("handctl: error: {e}");
+            ExitCode::from(e.exit_code())
+        }
+    }
+}

@@ -1,0 +1,98 @@
+//! `handctl train` and `handctl check`.
+
+use decoder::model::{train, Dataset, ModelKind, ModelSpec, TrainConfig, TrainedModel};
+use decoder::session::{check_gates, GateConfig, Session, WindowOptions};
+
+use super::args::{CheckArgs, TrainArgs, TrainingOpts};
+use super::error::CliError;
+use super::progress::Progress;
+
+/// Runs the quality gates, printing the report to stderr; an error when they fail and the
+/// user did not say to go on anyway.
+pub(super) fn gate(session: &Session, opts: &TrainingOpts) -> Result<(), CliError> {
+    let report = check_gates(session, &GateConfig::default())?;
+    if report.passed() {
+        for n in &report.notes {
+            eprintln!("{}: note: {n}", session.name.display());
+        }
+        return Ok(());
+    }
+    eprint!("{}: quality gates:\n{report}", session.name.display());
+    if opts.ignore_gates {
+        eprintln!("--ignore-gates: training anyway");
+        Ok(())
+    } else {
+        Err(CliError::Gates(report.issues.len()))
+    }
+}
+
+/// Trains one model with the CLI's settings, showing progress on a terminal.
+pub(super) fn fit(
+    kind: ModelKind,
+    data: &Dataset,
+    opts: &TrainingOpts,
+) -> Result<TrainedModel, CliError> {
+    let cfg = TrainConfig {
+        max_epochs: opts.epochs,
+        seed: opts.seed,
+        ..TrainConfig::default()
+    };
+    let mut progress = Progress::new(kind.name());
+    let model = train(kind, &ModelSpec::default(), data, &cfg, &mut |r| {
+        progress.epoch(&r)
+    });
+    progress.finish();
+    Ok(model?)
+}
+
+/// One line on what training did.
+pub(super) fn describe(model: &TrainedModel) -> String {
+    let s = model.summary();
+    let val = s
+        .best_val_loss
+        .map_or("no held-out trials".to_string(), |v| {
+            format!("held-out loss {v:.5}")
+        });
+    format!(
+        "{}: {} epochs (best {}{}), train loss {:.5}, {val}; {} windows from {} trials; {:.2} s",
+        s.kind,
+        s.epochs_run,
+        s.best_epoch,
+        if s.stopped_early {
+            ", stopped early"
+        } else {
+            ""
+        },
+        s.final_train_loss,
+        s.n_train_windows,
+        s.n_train_trials,
+        s.duration_ms as f64 / 1000.0
+    )
+}
+
+/// `handctl train`.
+pub fn run(a: &TrainArgs) -> Result<(), CliError> {
+    let session = Session::open_spec(&a.session)?;
+    gate(&session, &a.training)?;
+    let windows = session.windows(&WindowOptions {
+        two_point: a.training.two_point,
+    })?;
+    let data = windows.to_dataset(&session.meta.chain)?;
+    let model = fit(a.model, &data, &a.training)?;
+    model.save(&a.output)?;
+    println!("{}", describe(&model));
+    println!("wrote {}", a.output.display());
+    Ok(())
+}
+
+/// `handctl check`.
+pub fn run_check(a: &CheckArgs) -> Result<(), CliError> {
+    let session = Session::open_spec(&a.session)?;
+    let report = check_gates(&session, &GateConfig::default())?;
+    print!("{report}");
+    if report.passed() {
+        Ok(())
+    } else {
+        Err(CliError::Gates(report.issues.len()))
+    }
+}
