@@ -1,0 +1,146 @@
+//! `handd`: the handstack daemon. Reads sEMG from the amplifier on the CAN bus, runs the signal
+//! chain and the model every 50 ms, and sends per-finger setpoints to the motor controllers.
+//! See README.md ("Installing handd on the board") and `handd --help`.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::atomic::AtomicBool;
+use std::sync::{mpsc, Arc};
+use std::time::{Duration, Instant};
+
+use clap::Parser;
+use decoder::model::Model as _;
+use driver::config::{Config, DEFAULT_CONFIG_PATH};
+use driver::control::ControlServer;
+use driver::daemon::Runner;
+use driver::engine::Engine;
+use driver::rt::{lock_memory, set_fifo, RtReport};
+use driver::service::ControlHandler;
+use driver::socketcan_bus::SocketCanTransport;
+use driver::startup::{engine_settings, load_model};
+use hand_model::{Clock, SystemClock};
+
+/// The handstack daemon.
+#[derive(Parser, Debug)]
+#[command(version, about)]
+struct Args {
+    /// Config file.
+    #[arg(long, default_value = DEFAULT_CONFIG_PATH)]
+    config: PathBuf,
+    /// Log as JSON lines (for log collectors) instead of human-readable text.
+    #[arg(long)]
+    json_logs: bool,
+    /// SCHED_FIFO priority of the control loop (1-99); normal scheduling if not given.
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=99))]
+    rt_priority: Option<u8>,
+    /// Check the config and the model, print what would run, and exit.
+    #[arg(long)]
+    check: bool,
+}
+
+fn init_logs(json: bool) {
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
+    let builder = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr);
+    // Under systemd the journal adds its own timestamps.
+    let journald = std::env::var_os("JOURNAL_STREAM").is_some();
+    if json {
+        builder.json().init();
+    } else if journald {
+        builder.without_time().with_ansi(false).init();
+    } else {
+        builder.init();
+    }
+}
+
+fn main() -> ExitCode {
+    let args = Args::parse();
+    init_logs(args.json_logs);
+    match run(&args) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            tracing::error!("{e}");
+            eprintln!("handd: refusing to start: {e}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run(args: &Args) -> Result<(), String> {
+    let config = Config::load(&args.config).map_err(|e| e.to_string())?;
+    let loaded = load_model(&config.model, config.mains_hz).map_err(|e| e.to_string())?;
+    tracing::info!(
+        config = %args.config.display(),
+        model = %config.model.display(),
+        kind = %loaded.model.model().kind(),
+        model_id = format!("{:08x}", loaded.model_id),
+        interface = %config.interface,
+        "config and model validated"
+    );
+    if args.check {
+        println!(
+            "config {} and model {} ({}, id {:08x}) are valid; interface {}",
+            args.config.display(),
+            config.model.display(),
+            loaded.model.model().kind(),
+            loaded.model_id,
+            config.interface
+        );
+        return Ok(());
+    }
+
+    let mut rt = RtReport::default();
+    lock_memory(&mut rt);
+    if let Some(p) = args.rt_priority {
+        set_fifo(p, &mut rt);
+    }
+    for w in &rt.warnings {
+        tracing::warn!("{w}");
+    }
+
+    let clock = SystemClock::new();
+    let transport =
+        SocketCanTransport::open(&config.interface, clock).map_err(|e| format!("bus: {e}"))?;
+    let settings = engine_settings(&config, loaded.model_id);
+    let mut engine = Engine::new(
+        &loaded.chain,
+        loaded.model.predictor(),
+        settings,
+        clock.now_us(),
+    );
+    engine.validated(clock.now_us());
+
+    let (tx, rx) = mpsc::channel();
+    let mut runner = Runner::new(engine, transport, clock, config.tick_ms * 1000).with_commands(rx);
+    let server = ControlServer::bind(&config.control.socket, config.control.group.as_deref())
+        .map_err(|e| e.to_string())?;
+    let mut handler =
+        ControlHandler::new(config.clone(), args.config.clone(), runner.snapshot(), tx);
+    std::thread::Builder::new()
+        .name("handd-control".into())
+        .spawn(move || server.serve(move |req, peer| handler.handle(req, peer)))
+        .map_err(|e| format!("control thread: {e}"))?;
+
+    let stop = Arc::new(AtomicBool::new(false));
+    for sig in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
+        signal_hook::flag::register(sig, Arc::clone(&stop)).map_err(|e| format!("signals: {e}"))?;
+    }
+    let _ = sd_notify::notify(&[sd_notify::NotifyState::Ready]);
+    tracing::info!(socket = %config.control.socket.display(), "running");
+    let watchdog = sd_notify::watchdog_enabled().map(|d| d / 2);
+    let mut last_ping = Instant::now();
+    runner.run_realtime(&stop, |r| {
+        // Ping only while ticks meet their deadlines: a stalled loop gets restarted.
+        if let Some(every) = watchdog {
+            if r.last_tick_on_time() && last_ping.elapsed() >= every.min(Duration::from_secs(1)) {
+                let _ = sd_notify::notify(&[sd_notify::NotifyState::Watchdog]);
+                last_ping = Instant::now();
+            }
+        }
+    });
+    let _ = sd_notify::notify(&[sd_notify::NotifyState::Stopping]);
+    tracing::info!("stopping");
+    Ok(())
+}

@@ -1,0 +1,139 @@
+//! The daemon's side of the technicians' protocol: answers `status`, applies `tune` (checked,
+//! persisted atomically, audited, then handed to the loop for the next tick), `arm` and `stop`.
+
+use std::path::PathBuf;
+use std::sync::mpsc::Sender;
+
+use crate::config::Config;
+use crate::control::Peer;
+use crate::daemon::SharedSnapshot;
+use crate::engine::Command;
+use crate::protocol::{FingerStatus, Reply, Request, Status};
+use crate::tuning::{commit_tune, plan_tune, user_name};
+use crate::units::{FINGER_NAMES, N_FINGERS};
+
+/// Handles control requests for a running loop.
+pub struct ControlHandler {
+    config: Config,
+    config_path: PathBuf,
+    snapshot: SharedSnapshot,
+    commands: Sender<Command>,
+}
+
+impl ControlHandler {
+    /// A handler for the loop behind `snapshot` and `commands`; `config` is what `config_path`
+    /// holds now.
+    pub fn new(
+        config: Config,
+        config_path: PathBuf,
+        snapshot: SharedSnapshot,
+        commands: Sender<Command>,
+    ) -> Self {
+        Self {
+            config,
+            config_path,
+            snapshot,
+            commands,
+        }
+    }
+
+    /// The status as `handctl status` shows it.
+    pub fn status(&self) -> Status {
+        let s = *self.snapshot.lock().unwrap_or_else(|e| e.into_inner());
+        Status {
+            state: s.state.to_string(),
+            faults: s.faults.to_string(),
+            ticks: s.counters.ticks,
+            deadline_misses: s.counters.deadline_misses,
+            samples_lost: s.counters.samples_lost,
+            bad_frames: s.counters.bad_frames,
+            latency: s.latency,
+            compute: s.compute,
+            fingers: (0..N_FINGERS)
+                .map(|f| FingerStatus {
+                    label: s.setpoints[f].label,
+                    force_n: s.setpoints[f].force.0,
+                    velocity_rad_s: s.setpoints[f].velocity.0,
+                    reported_force_n: s.reported_force[f],
+                    disabled: s.disabled[f],
+                    kf: s.gains[f].kf,
+                    kalpha: s.gains[f].kalpha,
+                })
+                .collect(),
+        }
+    }
+
+    fn send(&self, cmd: Command) -> Result<(), Box<Reply>> {
+        self.commands.send(cmd).map_err(|_| {
+            Box::new(Reply::Refused {
+                reason: "the control loop is not running".into(),
+            })
+        })
+    }
+
+    /// Answer one request from `peer`.
+    pub fn handle(&mut self, req: Request, peer: Peer) -> Reply {
+        let user = user_name(peer.uid);
+        match req {
+            Request::Status => Reply::Ok {
+                message: "status".into(),
+                status: Some(self.status()),
+            },
+            Request::Tune { finger, kf, kalpha } => {
+                let change = match plan_tune(&self.config, &finger, kf, kalpha) {
+                    Ok(c) => c,
+                    Err(reason) => return Reply::Refused { reason },
+                };
+                let next = match commit_tune(&self.config, &change, &self.config_path, &user) {
+                    Ok(n) => n,
+                    Err(reason) => return Reply::Refused { reason },
+                };
+                if let Err(r) = self.send(Command::SetGains(change.finger, change.new.gains())) {
+                    return *r;
+                }
+                self.config = next;
+                tracing::info!(
+                    user,
+                    finger = FINGER_NAMES[change.finger],
+                    old_kf = change.old.kf,
+                    new_kf = change.new.kf,
+                    old_kalpha = change.old.kalpha,
+                    new_kalpha = change.new.kalpha,
+                    "tuned"
+                );
+                Reply::Ok {
+                    message: format!(
+                        "{}: kf {} -> {} N, kalpha {} -> {} rad/s²; takes effect at the next tick; saved to {}",
+                        FINGER_NAMES[change.finger],
+                        change.old.kf,
+                        change.new.kf,
+                        change.old.kalpha,
+                        change.new.kalpha,
+                        self.config_path.display()
+                    ),
+                    status: None,
+                }
+            }
+            Request::Arm => match self.send(Command::Arm) {
+                Ok(()) => {
+                    tracing::warn!(user, "armed by a technician");
+                    Reply::Ok {
+                        message: "armed: latched faults cleared; the hand moves after 500 ms of good signal".into(),
+                        status: None,
+                    }
+                }
+                Err(r) => *r,
+            },
+            Request::Stop => match self.send(Command::Stop) {
+                Ok(()) => {
+                    tracing::warn!(user, "stopped by a technician");
+                    Reply::Ok {
+                        message: "stopped: every finger safe-stopped until `handctl arm`".into(),
+                        status: None,
+                    }
+                }
+                Err(r) => *r,
+            },
+        }
+    }
+}
