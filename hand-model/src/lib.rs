@@ -15,7 +15,8 @@
 //! - [`nodes`]: the bus nodes, each stepped by `poll(now_us, &mut bus)`: amplifier, motor
 //!   controllers, fault injector, and a setpoint source standing in for the daemon in tests.
 //! - [`faults`]: faults on demand ([`faults::Fault`], [`faults::FaultPlan`]).
-//! - [`world`] and [`scenario`]: all nodes and the patient together, and named scenarios.
+//! - [`world`] and [`scenario`]: all nodes and the patient together, and named scenarios;
+//!   [`record`] runs a world faster than real time and shows every frame (sessions, demo).
 //!
 //! Fingers are indexed 0 thumb, 1 index, 2 middle, 3 ring, 4 pinky (the paper's L(5-f)).
 
@@ -28,6 +29,7 @@ pub mod faults;
 pub mod finger;
 pub mod nodes;
 pub mod patient;
+pub mod record;
 pub mod scenario;
 pub mod socketcan_bus;
 pub mod world;

@@ -8,12 +8,12 @@ use std::time::Duration;
 
 use clap::Parser;
 use hand_dbc::candump::LogWriter;
-use hand_model::bus::MemBus;
-use hand_model::clock::{Clock, SystemClock, VirtualClock};
+use hand_model::clock::{Clock, SystemClock};
 use hand_model::emg::AmplifierConfig;
 use hand_model::faults::{Fault, FaultPlan};
 use hand_model::finger::FingerConfig;
 use hand_model::nodes::{AmplifierNodeConfig, Bus};
+use hand_model::record::run_on_mem_bus;
 use hand_model::scenario::Scenario;
 use hand_model::socketcan_bus::SocketCanBus;
 use hand_model::world::{NodeSelection, World, WorldConfig};
@@ -185,8 +185,6 @@ fn run() -> Result<(), String> {
             Ok(())
         }
         (None, true) => {
-            let clock = VirtualClock::new();
-            let bus = MemBus::with_clock(clock.clone()).with_capacity(1 << 22);
             let mut log = match &args.session_out {
                 Some(dir) => {
                     std::fs::create_dir_all(dir)
@@ -198,25 +196,16 @@ fn run() -> Result<(), String> {
                 }
                 None => None,
             };
-            let mut monitor = bus.endpoint();
-            let mut world = World::try_new(cfg, run.patient, || {
-                Ok::<_, std::convert::Infallible>(bus.endpoint())
-            })
-            .map_err(|e| e.to_string())?;
             let mut per_id: BTreeMap<u32, u64> = BTreeMap::new();
-            let mut t = 0;
-            while t <= duration_us {
-                clock.set_us(t);
-                world.step(t);
-                while let Some(r) = monitor.receive_timestamped() {
-                    *per_id.entry(r.frame.raw_id()).or_default() += 1;
-                    if let Some((w, path)) = &mut log {
-                        w.write_frame(r.time_us.unwrap_or(t), "can0", &r.frame)
-                            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-                    }
+            run_on_mem_bus(cfg, run.patient, duration_us, |t, frame| {
+                *per_id.entry(frame.raw_id()).or_default() += 1;
+                if let Some((w, path)) = &mut log {
+                    w.write_frame(t, "can0", frame)
+                        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
                 }
-                t += 1000;
-            }
+                Ok::<_, String>(())
+            })
+            .map_err(|e| e.to_string())??;
             if let (Some((mut w, path)), Some(dir), Some(text)) =
                 (log, &args.session_out, &session_toml)
             {
