@@ -5,6 +5,7 @@ pub mod conditioner;
 pub mod config;
 pub mod control;
 pub mod daemon;
+pub mod demo;
 pub mod engine;
 pub mod protocol;
 pub mod rt;
