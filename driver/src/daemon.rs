@@ -106,8 +106,13 @@ impl<T: Transport, K: Clock> Runner<T, K> {
 
     /// Commands from the control thread.
     pub fn with_commands(mut self, rx: Receiver<Command>) -> Self {
-        self.commands = Some(rx);
+        self.set_commands(rx);
         self
+    }
+
+    /// Commands from the control thread (replacing any earlier channel).
+    pub fn set_commands(&mut self, rx: Receiver<Command>) {
+        self.commands = Some(rx);
     }
 
     /// The snapshot the loop publishes.

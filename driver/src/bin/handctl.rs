@@ -1,8 +1,8 @@
-//! `handctl`: the technician's command line for the hand (calibration training, evaluation,
-//! importing recordings). See `handctl --help`.
+//! `handctl`: the technician's command line for the hand: calibration training, evaluation,
+//! importing recordings, the running daemon's status, live tuning, arm and stop, and the demo.
+//! See `handctl --help`.
 
-// The CLI lives in driver/src/cli so that later subcommands (status, tune, arm, stop, demo)
-// get a module each beside the existing ones.
+// The CLI lives in driver/src/cli, one module per subcommand.
 #[path = "../cli/mod.rs"]
 mod cli;
 

@@ -26,6 +26,80 @@ pub enum Command {
     Import3dc(Import3dcArgs),
     /// Run the quality gates on a session and say which trials to redo.
     Check(CheckArgs),
+    /// Show the running daemon's state, faults, latency and per-finger values.
+    Status(StatusArgs),
+    /// Change one finger's kF and/or kα on the running daemon (saved to its config).
+    Tune(TuneArgs),
+    /// Clear latched faults (E-stop, bus-off, repeated E2E errors, stop).
+    Arm(DaemonOpts),
+    /// Safe-stop every finger until `handctl arm`.
+    Stop(DaemonOpts),
+    /// The whole system in one process: calibrate the simulated patient, train ResDD, drive
+    /// the simulated hand while the patient tracks a sine, and score the tracking.
+    Demo(DemoArgs),
+}
+
+/// How to reach the running daemon.
+#[derive(Debug, Clone, Args)]
+pub struct DaemonOpts {
+    /// handd's control socket (default: the one in the config file).
+    #[arg(long)]
+    pub socket: Option<PathBuf>,
+    /// handd's config file, to find the socket (default /etc/handstack/handd.toml).
+    #[arg(long)]
+    pub config: Option<PathBuf>,
+}
+
+/// `handctl status`.
+#[derive(Debug, Args)]
+pub struct StatusArgs {
+    #[command(flatten)]
+    pub daemon: DaemonOpts,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `handctl tune`.
+#[derive(Debug, Args)]
+pub struct TuneArgs {
+    /// Finger: thumb, index, middle, ring, pinky (or 0-4).
+    #[arg(long)]
+    pub finger: String,
+    /// New force gain kF, N per label unit (0 to 40).
+    #[arg(long)]
+    pub kf: Option<f64>,
+    /// New acceleration gain kα, rad/s² per label unit (0 to 50).
+    #[arg(long)]
+    pub kalpha: Option<f64>,
+    #[command(flatten)]
+    pub daemon: DaemonOpts,
+}
+
+/// `handctl demo`.
+#[derive(Debug, Args)]
+pub struct DemoArgs {
+    /// Run the tracking on a virtual clock, as fast as the machine goes.
+    #[arg(long)]
+    pub fast: bool,
+    /// Seconds of scored sine tracking (after 4 s of settling).
+    #[arg(long, default_value_t = 20.0, value_parser = parse_seconds)]
+    pub seconds: f64,
+    /// Seed of the simulated amplifier and patient.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Where the calibration session and the model are written (default: a temp directory).
+    #[arg(long)]
+    pub dir: Option<PathBuf>,
+}
+
+fn parse_seconds(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
+    if (4.0..=3600.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{v} s: allowed 4 to 3600"))
+    }
 }
 
 /// Training settings shared by train and eval.

@@ -1,6 +1,8 @@
 //! The `handctl` commands: one module per subcommand, the argument structures in `args`.
 
 mod args;
+mod daemon;
+mod demo;
 mod error;
 mod eval;
 mod import;
@@ -22,6 +24,11 @@ pub fn run() -> ExitCode {
         Command::Eval(a) => eval::run(a),
         Command::Import3dc(a) => import::run_3dc(a),
         Command::Check(a) => train::run_check(a),
+        Command::Status(a) => daemon::status(&a.daemon, a.json),
+        Command::Tune(a) => daemon::tune(a),
+        Command::Arm(o) => daemon::arm(o),
+        Command::Stop(o) => daemon::stop(o),
+        Command::Demo(a) => demo::run(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

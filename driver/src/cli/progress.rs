@@ -8,6 +8,7 @@ use decoder::model::EpochReport;
 pub struct Progress {
     live: bool,
     label: String,
+    started: bool,
 }
 
 impl Progress {
@@ -16,6 +17,7 @@ impl Progress {
         Progress {
             live: std::io::stderr().is_terminal(),
             label: label.to_string(),
+            started: false,
         }
     }
 
@@ -24,6 +26,7 @@ impl Progress {
         if !self.live {
             return;
         }
+        self.started = true;
         let val = r
             .val_loss
             .map_or(String::new(), |v| format!("  held-out {v:.5}"));
@@ -40,6 +43,14 @@ impl Progress {
     pub fn finish(&mut self) {
         if self.live {
             eprintln!();
+        }
+    }
+
+    /// Ends the live line if an epoch was shown since the last call.
+    pub fn finish_if_started(&mut self) {
+        if self.started {
+            self.finish();
+            self.started = false;
         }
     }
 }

@@ -1,0 +1,129 @@
+//! `handctl status`, `tune`, `arm` and `stop`: requests to a running `handd` over its control
+//! socket.
+
+use std::path::PathBuf;
+
+use driver::config::{Config, DEFAULT_CONFIG_PATH};
+use driver::control::request;
+use driver::protocol::{Reply, Request, Status};
+use driver::units::FINGER_NAMES;
+
+use super::args::{DaemonOpts, TuneArgs};
+use super::error::CliError;
+
+/// The socket to talk to: `--socket`, else the one named in the config file, else the default.
+fn socket_of(o: &DaemonOpts) -> Result<PathBuf, CliError> {
+    if let Some(s) = &o.socket {
+        return Ok(s.clone());
+    }
+    let path = o
+        .config
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_CONFIG_PATH));
+    match Config::load(&path) {
+        Ok(c) => Ok(c.control.socket),
+        // Without an explicit --config, a missing default file just means the default socket.
+        Err(_) if o.config.is_none() && !path.exists() => Ok(Config::default().control.socket),
+        Err(e) => Err(CliError::Usage(format!("cannot find handd's socket: {e}"))),
+    }
+}
+
+fn ask(o: &DaemonOpts, req: &Request) -> Result<Reply, CliError> {
+    let socket = socket_of(o)?;
+    request(&socket, req).map_err(|e| CliError::Usage(e.to_string()))
+}
+
+fn done(reply: Reply) -> Result<Option<Status>, CliError> {
+    match reply {
+        Reply::Ok { message, status } => {
+            if status.is_none() {
+                println!("{message}");
+            }
+            Ok(status)
+        }
+        Reply::Refused { reason } => Err(CliError::Usage(format!("handd refused: {reason}"))),
+    }
+}
+
+/// The status as a table.
+pub fn format_status(s: &Status) -> String {
+    let mut out = format!(
+        "state {}   faults {}\n\
+         ticks {}   deadline misses {}   EMG samples lost {}   bad frames {}\n\
+         latency (newest sample -> setpoints) p50 {} us  p99 {} us  max {} us\n\
+         compute per tick                     p50 {} us  p99 {} us  max {} us\n\n\
+         {:<7} {:>7} {:>9} {:>11} {:>11} {:>7} {:>7}  {}\n",
+        s.state,
+        s.faults,
+        s.ticks,
+        s.deadline_misses,
+        s.samples_lost,
+        s.bad_frames,
+        s.latency.p50_us,
+        s.latency.p99_us,
+        s.latency.max_us,
+        s.compute.p50_us,
+        s.compute.p99_us,
+        s.compute.max_us,
+        "finger",
+        "label",
+        "force N",
+        "vel rad/s",
+        "reported N",
+        "kf",
+        "kalpha",
+        "",
+    );
+    for (f, st) in s.fingers.iter().enumerate() {
+        out.push_str(&format!(
+            "{:<7} {:>7.3} {:>9.2} {:>11.3} {:>11.2} {:>7.2} {:>7.2}  {}\n",
+            FINGER_NAMES.get(f).copied().unwrap_or("?"),
+            st.label,
+            st.force_n,
+            st.velocity_rad_s,
+            st.reported_force_n,
+            st.kf,
+            st.kalpha,
+            if st.disabled { "DISABLED" } else { "" }
+        ));
+    }
+    out
+}
+
+/// `handctl status`.
+pub fn status(o: &DaemonOpts, json: bool) -> Result<(), CliError> {
+    let status = done(ask(o, &Request::Status)?)?
+        .ok_or_else(|| CliError::Usage("handd sent no status".into()))?;
+    if json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&status).map_err(|e| CliError::Usage(e.to_string()))?
+        );
+    } else {
+        print!("{}", format_status(&status));
+    }
+    Ok(())
+}
+
+/// `handctl tune`.
+pub fn tune(a: &TuneArgs) -> Result<(), CliError> {
+    done(ask(
+        &a.daemon,
+        &Request::Tune {
+            finger: a.finger.clone(),
+            kf: a.kf,
+            kalpha: a.kalpha,
+        },
+    )?)
+    .map(drop)
+}
+
+/// `handctl arm`.
+pub fn arm(o: &DaemonOpts) -> Result<(), CliError> {
+    done(ask(o, &Request::Arm)?).map(drop)
+}
+
+/// `handctl stop`.
+pub fn stop(o: &DaemonOpts) -> Result<(), CliError> {
+    done(ask(o, &Request::Stop)?).map(drop)
+}

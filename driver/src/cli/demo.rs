@@ -1,0 +1,99 @@
+//! `handctl demo`: the whole system in one process over the in-memory bus (see
+//! `driver::demo`), with live per-finger state on the terminal and the tracking scores at the
+//! end.
+
+use std::io::{IsTerminal, Write};
+
+use driver::demo::{run_demo, DemoEvent, DemoOptions};
+use driver::units::FINGER_NAMES;
+
+use super::args::DemoArgs;
+use super::error::CliError;
+use super::progress::Progress;
+
+/// `handctl demo`.
+pub fn run(a: &DemoArgs) -> Result<(), CliError> {
+    let opts = DemoOptions {
+        seed: a.seed,
+        fast: a.fast,
+        track_s: a.seconds + 4.0,
+        settle_s: 4.0,
+        work_dir: a
+            .dir
+            .clone()
+            .unwrap_or_else(|| std::env::temp_dir().join("handstack-demo")),
+        ..DemoOptions::default()
+    };
+    let tty = std::io::stdout().is_terminal();
+    let mut progress = Progress::new("resdd");
+    let mut last_print = -1.0;
+    let report = run_demo(&opts, |e| match e {
+        DemoEvent::Phase(p) => {
+            progress.finish_if_started();
+            println!("== {p}");
+        }
+        DemoEvent::Epoch(r) => progress.epoch(&r),
+        DemoEvent::Live {
+            t_s,
+            snapshot,
+            target,
+            tracked,
+        } => {
+            // On a terminal: one live block; in a pipe: a line a second.
+            if !tty && t_s - last_print < 1.0 {
+                return;
+            }
+            last_print = t_s;
+            let fingers: Vec<String> = (0..5)
+                .map(|f| {
+                    format!(
+                        "{} {:+.2}/{:+5.1}N",
+                        &FINGER_NAMES[f][..2],
+                        snapshot.setpoints[f].label,
+                        snapshot.reported_force[f]
+                    )
+                })
+                .collect();
+            let line = format!(
+                "t {t_s:5.1}s {:<7} target {target:+.2} index {tracked:+.2} | {}",
+                snapshot.state.to_string(),
+                fingers.join(" ")
+            );
+            if tty {
+                print!("\r{line}  ");
+                let _ = std::io::stdout().flush();
+            } else {
+                println!("{line}");
+            }
+        }
+    })
+    .map_err(|e| CliError::Usage(format!("demo: {e}")))?;
+    if tty {
+        println!();
+    }
+    println!(
+        "calibration: {} trials in {}; model {} ({} epochs, {:.2} s)",
+        report.trials,
+        report.session_dir.display(),
+        report.model_path.display(),
+        report.epochs,
+        report.train_ms as f64 / 1000.0
+    );
+    println!(
+        "tracking (index finger, sine amplitude 1, period 4 s, {} samples): RMSE {:.3}  MAPE {}  R² {:.3}",
+        report.samples,
+        report.rmse,
+        report.mape.map_or("n/a".into(), |m| format!("{m:.1}%")),
+        report.r2
+    );
+    println!(
+        "daemon: latency p50 {} us p99 {} us, compute p50 {} us p99 {} us, deadline misses {}, state {}",
+        report.end.latency.p50_us,
+        report.end.latency.p99_us,
+        report.end.compute.p50_us,
+        report.end.compute.p99_us,
+        report.end.counters.deadline_misses,
+        report.end.state
+    );
+    Ok(())
+}
