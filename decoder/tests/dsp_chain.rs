@@ -205,3 +205,52 @@ fn a_silent_channel_settles_to_exact_zero_not_subnormals() {
     assert!(chain.last_filtered().iter().all(|&v| v == 0.0));
     assert!(chain.features().iter().all(|&v| v == 0.0));
 }
+
+#[test]
+fn features_equal_the_formulas_over_the_processed_window() {
+    // Both feature paths: window a whole number of steps (per-block statistics merged) and not
+    // (the whole window revisited). Each must equal window_features of the last window of
+    // |filtered| to rounding.
+    for (step_ms, rectified) in [(50.0, true), (30.0, true), (50.0, false), (7.0, false)] {
+        let s = ChainConfig {
+            channels: 3,
+            step_ms,
+            feature_signal: if rectified {
+                decoder::dsp::FeatureSignal::Rectified
+            } else {
+                decoder::dsp::FeatureSignal::Filtered
+            },
+            ..ChainConfig::default()
+        }
+        .validate()
+        .expect("valid configuration");
+        let x: Vec<f64> = (0..1500).flat_map(|n| sample(n, 3)).collect();
+        let filtered = decoder::dsp::batch_filtered(&s, &x).expect("whole samples");
+        let mut chain = Chain::new(&s);
+        let mut checked = 0;
+        for (n, v) in x.chunks_exact(3).enumerate() {
+            if !chain.push(v) {
+                continue;
+            }
+            for c in 0..3 {
+                let window: Vec<f64> = (n + 1 - s.window_len()..=n)
+                    .map(|i| filtered[i * 3 + c])
+                    .map(|y| if rectified { y.abs() } else { y })
+                    .collect();
+                let want = decoder::dsp::window_features(&window);
+                for (k, (a, b)) in chain.features()[c * 8..c * 8 + 8]
+                    .iter()
+                    .zip(want)
+                    .enumerate()
+                {
+                    assert!(
+                        (a - b).abs() <= 1e-12 * b.abs().max(1e-300),
+                        "step {step_ms} ms, sample {n}, channel {c}, feature {k}: {a} vs {b}"
+                    );
+                }
+            }
+            checked += 1;
+        }
+        assert_eq!(checked, s.n_windows(1500));
+    }
+}

@@ -2,7 +2,7 @@
 
 use super::config::{ChainSettings, FeatureSignal};
 use super::faults::{Faults, MAX_ABS_SAMPLE};
-use super::features::{features_into, FEATURES_PER_CHANNEL};
+use super::features::{features_into, Stats, FEATURES_PER_CHANNEL};
 
 /// Filter state smaller than this is set to exactly 0 (every [`FLUSH_EVERY`] samples). Without
 /// it a silent channel's IIR state decays into subnormal numbers and stays there in a limit
@@ -44,6 +44,14 @@ pub struct Chain {
     emitted: u64,
     /// Samples still to push before the next feature vector.
     until_features: usize,
+    /// When the window is a whole number of steps: statistics of each step-long block of the
+    /// window, `[channel][block]`, a ring starting at `block_head` (the oldest), so each
+    /// feature vector only visits the newest `step_len` samples. Empty otherwise (every
+    /// feature vector then visits the whole window).
+    blocks: Vec<Stats>,
+    blocks_per_window: usize,
+    block_head: usize,
+    until_block: usize,
     features: Vec<f64>,
     /// The current sample of every channel on its way through the cascade; after it, the
     /// filtered output.
@@ -57,11 +65,17 @@ impl Chain {
         let n_channels = settings.n_channels();
         let n_state = n_channels * settings.cascade().len();
         let window_len = settings.window_len();
+        let step_len = settings.step_len();
+        let blocks_per_window = if window_len.is_multiple_of(step_len) {
+            window_len / step_len
+        } else {
+            0
+        };
         Chain {
             settings: settings.clone(),
             n_channels,
             window_len,
-            step_len: settings.step_len(),
+            step_len,
             rectify: settings.config().feature_signal == FeatureSignal::Rectified,
             z0: vec![0.0; n_state],
             z1: vec![0.0; n_state],
@@ -70,6 +84,10 @@ impl Chain {
             count: 0,
             emitted: 0,
             until_features: window_len,
+            blocks: vec![Stats::default(); n_channels * blocks_per_window],
+            blocks_per_window,
+            block_head: 0,
+            until_block: step_len,
             features: vec![0.0; settings.n_features()],
             last_filtered: vec![0.0; n_channels],
             faults: Faults::new(n_channels, window_len),
@@ -86,6 +104,9 @@ impl Chain {
         self.count = 0;
         self.emitted = 0;
         self.until_features = self.window_len;
+        self.blocks.fill(Stats::default());
+        self.block_head = 0;
+        self.until_block = self.step_len;
         self.features.fill(0.0);
         self.last_filtered.fill(0.0);
         self.faults.clear();
@@ -169,6 +190,14 @@ impl Chain {
         }
         self.head = if head + 1 == w { 0 } else { head + 1 };
 
+        if self.blocks_per_window > 0 {
+            self.until_block -= 1;
+            if self.until_block == 0 {
+                self.until_block = self.step_len;
+                self.summarize_newest_block();
+            }
+        }
+
         self.until_features -= 1;
         if self.until_features == 0 {
             self.until_features = self.step_len;
@@ -180,14 +209,38 @@ impl Chain {
         }
     }
 
+    /// Statistics of the last `step_len` samples of every channel into the block ring.
+    fn summarize_newest_block(&mut self) {
+        let (w, s, nb) = (self.window_len, self.step_len, self.blocks_per_window);
+        for ch in 0..self.n_channels {
+            let end = ch * 2 * w + self.head + w;
+            self.blocks[ch * nb + self.block_head] = Stats::of(&self.ring[end - s..end]);
+        }
+        self.block_head = if self.block_head + 1 == nb {
+            0
+        } else {
+            self.block_head + 1
+        };
+    }
+
     fn compute_features(&mut self) {
         let w = self.window_len;
+        let nb = self.blocks_per_window;
         for ch in 0..self.n_channels {
-            let start = ch * 2 * w + self.head;
-            let window = &self.ring[start..start + w];
             let out =
                 &mut self.features[ch * FEATURES_PER_CHANNEL..(ch + 1) * FEATURES_PER_CHANNEL];
-            features_into(window, out);
+            if nb > 0 {
+                let blocks = &self.blocks[ch * nb..(ch + 1) * nb];
+                let (newer, older) = blocks.split_at(self.block_head);
+                older
+                    .iter()
+                    .chain(newer)
+                    .fold(Stats::default(), |acc, b| acc.then(b))
+                    .features_into(out);
+            } else {
+                let start = ch * 2 * w + self.head;
+                features_into(&self.ring[start..start + w], out);
+            }
         }
     }
 
