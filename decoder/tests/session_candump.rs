@@ -78,7 +78,7 @@ fn meta(channels: usize) -> SessionMeta {
         recording: RecordingSpec {
             format: RecordingFormat::Candump,
             file: PathBuf::from("frames.log"),
-            full_scale: Some(EmgSamplesG0::EMG0_MAX),
+            full_scale: Some(2047.0),
         },
         segments: Vec::new(),
         trials: vec![
@@ -152,5 +152,54 @@ fn a_log_without_emg_or_with_a_bad_line_is_refused() {
     std::fs::write(dir.join("frames.log"), "(1.000000) can0 123#00\ngarbage\n").unwrap();
     let e = Session::open(&dir).unwrap_err().to_string();
     assert!(e.contains("line 2"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn saturation_is_judged_in_bus_lsb() {
+    // Full-scale samples (raw ±2047 = ±5117.5 µV) in the flexion trial's channel 5.
+    let dir = temp_dir("candump-sat");
+    let mut out = LogWriter::new(Vec::new());
+    let mut p = [
+        E2eProtector::new(EmgSamplesG0::E2E),
+        E2eProtector::new(EmgSamplesG1::E2E),
+        E2eProtector::new(EmgSamplesG2::E2E),
+    ];
+    for i in 0..3000usize {
+        let v = |c: usize| {
+            if i >= 1500 && c == 5 && i % 4 == 0 {
+                2047.0 * EMG_LSB_UV
+            } else {
+                value_uv(i, c)
+            }
+        };
+        let t = T0_US + i as u64 * 1000;
+        let frames = [
+            p[0].protect_message(&EmgSamplesG0::new(v(0), v(1), v(2), v(3)).unwrap())
+                .unwrap(),
+            p[1].protect_message(&EmgSamplesG1::new(v(4), v(5), v(6), v(7)).unwrap())
+                .unwrap(),
+            p[2].protect_message(&EmgSamplesG2::new(v(8), v(9), v(10), v(11)).unwrap())
+                .unwrap(),
+        ];
+        for (g, f) in frames.iter().enumerate() {
+            out.write_frame(t + 100 * g as u64, "can0", f).unwrap();
+        }
+    }
+    std::fs::write(dir.join("frames.log"), out.into_inner()).unwrap();
+    meta(12).write(&dir).unwrap();
+    let s = Session::open(&dir).unwrap();
+    let r = decoder::session::check_gates(&s, &decoder::session::GateConfig::default()).unwrap();
+    let sat: Vec<_> = r
+        .issues
+        .iter()
+        .filter(|i| matches!(i.kind, decoder::session::GateKind::Saturated { .. }))
+        .collect();
+    assert_eq!(sat.len(), 1, "{r}");
+    assert_eq!(
+        sat[0].kind,
+        decoder::session::GateKind::Saturated { channel: 5 }
+    );
+    assert_eq!(sat[0].trial_id, 2);
     std::fs::remove_dir_all(&dir).unwrap();
 }

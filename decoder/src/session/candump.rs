@@ -94,5 +94,6 @@ pub(crate) fn load_candump(meta: &SessionMeta, path: &Path) -> Result<Recording,
         lost_samples: stats.lost_samples,
         breaks,
         bad_frames: bad_crc,
+        unit_per_raw: EMG_LSB_UV,
     })
 }

@@ -155,7 +155,8 @@ pub fn check_gates(session: &Session, config: &GateConfig) -> Result<GateReport,
                     (lo.min(v), hi.max(v))
                 });
             if let Some(fs) = session.meta.recording.full_scale {
-                let at_rail = column.filter(|v| v.abs() >= fs).count();
+                let rail = fs * session.recording.unit_per_raw;
+                let at_rail = column.filter(|v| v.abs() >= rail).count();
                 let frac = at_rail as f64 / n as f64;
                 if frac > config.saturation_fraction {
                     report.issues.push(GateIssue {

@@ -11,7 +11,7 @@
 //! [recording]
 //! format = "candump"         # or "npy": samples n x channels, sample i at i * 1e6 / rate µs
 //! file = "frames.log"        # relative to the session directory, or absolute
-//! full_scale = 2047.0        # optional: |raw| at or beyond this is saturated
+//! full_scale = 2047.0        # optional: |raw| (bus LSB, or file units) at or beyond this saturates
 //!
 //! [[segment]]                # optional: separate recordings, each filtered on its own
 //! start_us = 0
@@ -58,8 +58,9 @@ pub struct RecordingSpec {
     pub format: RecordingFormat,
     /// File, relative to the session directory or absolute.
     pub file: PathBuf,
-    /// Raw magnitude at which the front end saturates (same units as the samples); `None`:
-    /// unknown, saturation is then not checked.
+    /// Magnitude at which the front end saturates, in the stored integer units: raw bus LSB
+    /// for a candump log (2047 for the 12-bit EMG signals), file units for a sample file.
+    /// `None`: unknown, saturation is then not checked.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub full_scale: Option<f64>,
 }

@@ -21,6 +21,9 @@ pub struct Recording {
     pub breaks: Vec<usize>,
     /// Frames dropped for a wrong CRC (0 for sample files).
     pub bad_frames: u64,
+    /// Sample units per stored raw unit: µV per LSB for a candump log, 1 for sample files
+    /// (what `full_scale` is multiplied by).
+    pub unit_per_raw: f64,
 }
 
 impl Recording {
@@ -54,6 +57,7 @@ impl Recording {
             lost_samples: 0,
             breaks: Vec::new(),
             bad_frames: 0,
+            unit_per_raw: 1.0,
         })
     }
 
