@@ -40,6 +40,12 @@
 //! The feature vector is channel-major: `[ch0 RMS, ch0 MAV, .., ch0 DAMV, ch1 RMS, ..]`, 8 values
 //! per channel (96 for 12 channels).
 //!
+//! When the window is a whole number of steps (the default 200/50), each step's samples are
+//! summarised once (sums, in-block differences, mean and squared deviations, two-pass) and the
+//! window's features come from merging the last `window/step` summaries (VAR with Chan et al.'s
+//! pairwise formula), so a tick reads 50 samples per channel, not 200. Otherwise the whole
+//! window is revisited. Both equal the formulas above to rounding (checked against numpy).
+//!
 //! Use: validate a [`ChainConfig`] once into [`ChainSettings`] (the only fallible step), build a
 //! [`Chain`] from it, then [`Chain::push`] one multi-channel sample at a time; nothing after
 //! validation allocates, returns a `Result` or panics on any input. Non-finite (or absurdly
