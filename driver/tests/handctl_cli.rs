@@ -143,3 +143,100 @@ fn errors_are_clear() {
         text(&out.stderr)
     );
 }
+
+/// Pseudo-random noise in [-1, 1) without a dependency: a 64-bit LCG.
+fn noise(state: &mut u64) -> f64 {
+    *state = state
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    ((*state >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+}
+
+#[test]
+fn import_an_npy_recording_with_a_label_table_and_train_on_it() {
+    let dir = tmp("table");
+    std::fs::create_dir_all(&dir).unwrap();
+    // Four channels; rest, then flexion and extension of the index finger (channels 0 and 1)
+    // and the whole hand (all channels), two repetitions each, 2 s per trial.
+    let plan: [(&str, &str, [f64; 4]); 4] = [
+        ("all", "rest", [5.0; 4]),
+        ("index", "flexion", [120.0, 30.0, 5.0, 5.0]),
+        ("1", "extension", [30.0, 120.0, 5.0, 5.0]),
+        ("all", "flexion", [120.0, 30.0, 120.0, 30.0]),
+    ];
+    let mut samples = Vec::new();
+    let mut labels = String::from("finger,kind,repetition,start_sample,end_sample\n");
+    let mut rng = 7u64;
+    for rep in 1..=2 {
+        for (finger, kind, amps) in plan {
+            let start = samples.len() / 4;
+            for _ in 0..2000 {
+                for a in amps {
+                    samples.push((a * noise(&mut rng)).round());
+                }
+            }
+            labels.push_str(&format!("{finger},{kind},{rep},{start},{}\n", start + 2000));
+        }
+    }
+    let npy = dir.join("emg.npy");
+    decoder::session::write_npy_f64(&npy, samples.len() / 4, 4, &samples).unwrap();
+    std::fs::write(dir.join("labels.csv"), labels).unwrap();
+    let session = dir.join("session");
+    let out = handctl(&[
+        "import",
+        "--samples",
+        s(&npy),
+        "--labels",
+        s(&dir.join("labels.csv")),
+        "--channels",
+        "4",
+        "--rows-are-recordings",
+        "-o",
+        s(&session),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stdout).contains("8 trials"),
+        "{}",
+        text(&out.stdout)
+    );
+    let out = handctl(&["check", s(&session)]);
+    assert!(
+        out.status.success(),
+        "{}{}",
+        text(&out.stdout),
+        text(&out.stderr)
+    );
+    let model = dir.join("m.model");
+    let out = handctl(&[
+        "train",
+        s(&session),
+        "-o",
+        s(&model),
+        "--model",
+        "ln",
+        "--epochs",
+        "3",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(model.exists());
+    // A channel count that does not match the file is refused, naming the shape.
+    let out = handctl(&[
+        "import",
+        "--samples",
+        s(&npy),
+        "--labels",
+        s(&dir.join("labels.csv")),
+        "--channels",
+        "6",
+        "-o",
+        s(&dir.join("bad")),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        text(&out.stderr).contains("channels"),
+        "{}",
+        text(&out.stderr)
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

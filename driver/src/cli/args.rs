@@ -26,6 +26,9 @@ pub enum Command {
     Import3dc(Import3dcArgs),
     /// Run the quality gates on a session and say which trials to redo.
     Check(CheckArgs),
+    /// Write a session directory from an external recording: samples (NPY or CSV) plus a
+    /// label table CSV with the header finger,kind,repetition,start_sample,end_sample.
+    Import(ImportArgs),
     /// Show the running daemon's state, faults, latency and per-finger values.
     Status(StatusArgs),
     /// Change one finger's kF and/or kα on the running daemon (saved to its config).
@@ -160,6 +163,40 @@ pub struct Import3dcArgs {
     /// Which half of the recordings.
     #[arg(long, value_parser = ["train", "test"])]
     pub split: String,
+    /// Session directory to write.
+    #[arg(short, long)]
+    pub output: PathBuf,
+}
+
+/// `handctl import`.
+#[derive(Debug, Args)]
+pub struct ImportArgs {
+    /// Samples, n x channels: a .npy file (int16/int32/float32/float64) or a .csv file (one
+    /// sample per line, optional header).
+    #[arg(long)]
+    pub samples: PathBuf,
+    /// Label table CSV: finger (0-4, a name or all), kind (flexion|extension|rest), repetition,
+    /// start_sample, end_sample (exclusive); an id column is optional.
+    #[arg(long)]
+    pub labels: PathBuf,
+    /// Number of channels in the samples.
+    #[arg(long)]
+    pub channels: usize,
+    /// Sample rate in Hz.
+    #[arg(long, default_value_t = 1000.0)]
+    pub rate: f64,
+    /// Mains frequency to notch, 50 or 60 Hz.
+    #[arg(long, default_value_t = 50)]
+    pub mains: u32,
+    /// Each label row is a separate recording (filtered on its own from reset state).
+    #[arg(long)]
+    pub rows_are_recordings: bool,
+    /// Raw magnitude at which the recording saturates (enables the saturation gate).
+    #[arg(long)]
+    pub full_scale: Option<f64>,
+    /// Windows starting this soon (ms) after a trial's start are not used.
+    #[arg(long, default_value_t = 0.0)]
+    pub onset_skip_ms: f64,
     /// Session directory to write.
     #[arg(short, long)]
     pub output: PathBuf,

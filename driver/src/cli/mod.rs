@@ -24,6 +24,7 @@ pub fn run() -> ExitCode {
         Command::Eval(a) => eval::run(a),
         Command::Import3dc(a) => import::run_3dc(a),
         Command::Check(a) => train::run_check(a),
+        Command::Import(a) => import::run_table(a),
         Command::Status(a) => daemon::status(&a.daemon, a.json),
         Command::Tune(a) => daemon::tune(a),
         Command::Arm(o) => daemon::arm(o),
