@@ -212,3 +212,22 @@ fn csv_and_label_table_import() {
     assert!(e.contains("line 3") && e.contains("wiggle"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn the_last_repetition_of_each_kind_is_held_out() {
+    let (samples, meta) = synth(&clean_protocol(), 8);
+    let rec = decoder::session::Recording::from_samples(CHANNELS, samples, RATE).unwrap();
+    let s = Session::from_parts("synthetic".into(), meta, rec).unwrap();
+    let held = s.holdout_last_repetition();
+    for (t, h) in s.meta.trials.iter().zip(&held) {
+        assert_eq!(*h, t.repetition == 2, "{t}");
+    }
+}
+
+#[test]
+fn interpolation_scales_the_chain_s_var_column_by_k_squared() {
+    // The interpolation analysis assumes the chain's feature order; keep the two in step.
+    use decoder::eval::{FEATURES_PER_CHANNEL, VAR_INDEX};
+    assert_eq!(FEATURES_PER_CHANNEL, decoder::dsp::FEATURE_NAMES.len());
+    assert_eq!(decoder::dsp::FEATURE_NAMES[VAR_INDEX], "VAR");
+}
