@@ -37,6 +37,8 @@ pub enum Command {
     Arm(DaemonOpts),
     /// Safe-stop every finger until `handctl arm`.
     Stop(DaemonOpts),
+    /// Record a CAN bus to DIR/frames.log (candump) and, with handsim's trials, a session.
+    Record(RecordArgs),
     /// The whole system in one process: calibrate the simulated patient, train ResDD, drive
     /// the simulated hand while the patient tracks a sine, and score the tracking.
     Demo(DemoArgs),
@@ -120,6 +122,10 @@ pub struct TrainingOpts {
     /// Train even when the quality gates find trials to redo.
     #[arg(long)]
     pub ignore_gates: bool,
+    /// Validation split for early stopping: trial (whole trials held out), trial-tail (the
+    /// end of every trial; works with a one-repetition calibration), window or none.
+    #[arg(long, default_value = "trial", value_parser = parse_split)]
+    pub validation: decoder::model::ValidationSplit,
 }
 
 /// `handctl train`.
@@ -209,6 +215,40 @@ pub struct CheckArgs {
     pub session: String,
 }
 
+fn parse_split(s: &str) -> Result<decoder::model::ValidationSplit, String> {
+    s.parse()
+        .map_err(|e: decoder::model::TrainError| e.to_string())
+}
+
 fn parse_kind(s: &str) -> Result<ModelKind, String> {
     s.parse::<ModelKind>().map_err(|e| e.to_string())
+}
+
+/// `handctl record`.
+#[derive(Debug, Args)]
+pub struct RecordArgs {
+    /// SocketCAN interface to record, e.g. vcan0 or can0.
+    #[arg(long)]
+    pub iface: String,
+    /// Output directory: frames.log (candump format), and session.toml with --trials.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Seconds to record.
+    #[arg(long)]
+    pub duration: f64,
+    /// The trials file of `handsim --trials-out`: also write session.toml, the trials placed on
+    /// the log's time base (start handctl record before handsim).
+    #[arg(long)]
+    pub trials: Option<PathBuf>,
+    /// Mains frequency written into the session's chain settings, 50 or 60 Hz.
+    #[arg(long, default_value_t = 50, value_parser = parse_mains)]
+    pub mains: u32,
+}
+
+fn parse_mains(s: &str) -> Result<u32, String> {
+    match s {
+        "50" => Ok(50),
+        "60" => Ok(60),
+        _ => Err(format!("{s:?}: mains is 50 or 60 Hz")),
+    }
 }

@@ -7,6 +7,7 @@ mod error;
 mod eval;
 mod import;
 mod progress;
+mod record;
 mod train;
 
 use std::process::ExitCode;
@@ -29,6 +30,7 @@ pub fn run() -> ExitCode {
         Command::Tune(a) => daemon::tune(a),
         Command::Arm(o) => daemon::arm(o),
         Command::Stop(o) => daemon::stop(o),
+        Command::Record(a) => record::run(a),
         Command::Demo(a) => demo::run(a),
     };
     match result {

@@ -35,6 +35,7 @@ pub(super) fn fit(
     let cfg = TrainConfig {
         max_epochs: opts.epochs,
         seed: opts.seed,
+        split: opts.validation,
         ..TrainConfig::default()
     };
     let mut progress = Progress::new(kind.name());

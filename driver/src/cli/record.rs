@@ -1,0 +1,293 @@
+//! `handctl record`: records a SocketCAN bus to a candump log (kernel receive timestamps) and,
+//! given the trials `handsim --trials-out` wrote, a calibration session for `handctl train`.
+//!
+//! ## One time base
+//!
+//! The log's times are the kernel's receive timestamps (µs since the Unix epoch); handsim's
+//! trial times are µs since *its* scenario start. The scenario start is on the bus: handsim's
+//! amplifier sends sample 0 (EMG_SAMPLES_G0 with sample counter 0) at scenario time 0 and one
+//! sample per millisecond after it. So the recorder takes the receive time of the first
+//! EMG_SAMPLES_G0 frame as the scenario start and shifts every trial by it. That frame must
+//! carry counter 0: if it does not, the recorder started after handsim, the start is unknown,
+//! and the session is refused ("start handctl record before handsim"). The offset is off by
+//! the first frame's latency only (well under a millisecond on vcan, about 1 % of a 0.5 s
+//! plateau at worst even on a loaded machine), and the decoder's onset skip and windowing
+//! absorb it.
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::Path;
+use std::time::{Duration, Instant, UNIX_EPOCH};
+
+use hand_dbc::candump::LogWriter;
+use hand_dbc::CanFrame;
+use hand_model::emg::{ADC_MAX, N_CHANNELS};
+use hand_model::patient::CalibrationTrial;
+use serde::{Deserialize, Serialize};
+use socketcan::{CanSocket, EmbeddedFrame, Socket, SocketOptions};
+
+use super::args::RecordArgs;
+use super::error::CliError;
+
+/// EMG_SAMPLES_G0's id (hand.dbc): the frame that carries the sample counter first.
+const EMG_G0_ID: u32 = 0x100;
+/// The log file inside the output directory.
+const FRAMES_FILE: &str = "frames.log";
+
+/// What a recording saw.
+#[derive(Debug, Default, Clone, Copy)]
+struct Counts {
+    frames: u64,
+    error_frames: u64,
+    /// Receive time (µs since the epoch) of the first EMG_SAMPLES_G0 and its sample counter.
+    first_emg: Option<(u64, u8)>,
+}
+
+fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> CliError + '_ {
+    move |source| CliError::Io {
+        path: path.display().to_string(),
+        source,
+    }
+}
+
+/// Runs `handctl record`.
+pub fn run(a: &RecordArgs) -> Result<(), CliError> {
+    if !(a.duration.is_finite() && a.duration > 0.0) {
+        return Err(CliError::Usage(format!(
+            "--duration {}: must be a positive number of seconds",
+            a.duration
+        )));
+    }
+    // Read the trials first: a bad file should fail before a long recording, not after it.
+    let trials = match &a.trials {
+        Some(p) => Some(read_trials(p)?),
+        None => None,
+    };
+    std::fs::create_dir_all(&a.out).map_err(io_err(&a.out))?;
+    let log_path = a.out.join(FRAMES_FILE);
+    let socket = open(&a.iface)?;
+    eprintln!(
+        "handctl record: {} for {:.1} s -> {}",
+        a.iface,
+        a.duration,
+        log_path.display()
+    );
+    let counts = record(&socket, &a.iface, &log_path, a.duration)?;
+    eprintln!(
+        "handctl record: {} frames ({} error frames not logged)",
+        counts.frames, counts.error_frames
+    );
+    if let Some(trials) = trials {
+        let start_us = scenario_start(&counts)?;
+        let text = session_toml(&trials, start_us, a.mains)?;
+        let meta = a.out.join(decoder::session::META_FILE);
+        std::fs::write(&meta, text).map_err(io_err(&meta))?;
+        // The session must open: a recorder that writes what the trainer cannot read is broken.
+        let s = decoder::session::Session::open(&a.out)?;
+        eprintln!(
+            "handctl record: session {} with {} trials (scenario start at {}.{:06} s)",
+            a.out.display(),
+            s.meta.trials.len(),
+            start_us / 1_000_000,
+            start_us % 1_000_000
+        );
+    }
+    Ok(())
+}
+
+fn open(iface: &str) -> Result<CanSocket, CliError> {
+    driver::socketcan_bus::interface_up(iface).map_err(|e| CliError::Usage(e.to_string()))?;
+    let bad = |e: std::io::Error| CliError::Usage(format!("cannot open {iface:?}: {e}"));
+    let sock = CanSocket::open(iface).map_err(bad)?;
+    sock.set_recv_timestamp(true).map_err(bad)?;
+    sock.set_error_filter_accept_all().map_err(bad)?;
+    // A short timeout so the recording ends on time on a silent bus.
+    sock.set_read_timeout(Duration::from_millis(50))
+        .map_err(bad)?;
+    Ok(sock)
+}
+
+fn record(sock: &CanSocket, iface: &str, path: &Path, seconds: f64) -> Result<Counts, CliError> {
+    let file = File::create(path).map_err(io_err(path))?;
+    let mut log = LogWriter::new(BufWriter::new(file));
+    let mut counts = Counts::default();
+    let end = Instant::now() + Duration::from_secs_f64(seconds);
+    while Instant::now() < end {
+        let (frame, ts) = match sock.read_frame_with_timestamp() {
+            Ok(x) => x,
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) =>
+            {
+                continue
+            }
+            Err(e) => {
+                return Err(CliError::Usage(format!(
+                    "reading {iface:?} failed after {} frames: {e}",
+                    counts.frames
+                )))
+            }
+        };
+        let time_us = ts
+            .duration_since(UNIX_EPOCH)
+            .map(|d| d.as_micros() as u64)
+            .unwrap_or(0);
+        let ours = match frame {
+            socketcan::CanFrame::Data(d) => CanFrame::new(d.id(), d.data()),
+            socketcan::CanFrame::Remote(r) => CanFrame::new_remote(r.id(), r.dlc()),
+            socketcan::CanFrame::Error(_) => {
+                counts.error_frames += 1;
+                continue;
+            }
+        };
+        let Some(f) = ours else { continue };
+        if counts.first_emg.is_none() && f.raw_id() == EMG_G0_ID && f.data().len() >= 2 {
+            counts.first_emg = Some((time_us, f.data()[1]));
+        }
+        log.write_frame(time_us, iface, &f).map_err(io_err(path))?;
+        counts.frames += 1;
+    }
+    log.flush().map_err(io_err(path))?;
+    Ok(counts)
+}
+
+/// The scenario start on the log's time base (see the module doc).
+fn scenario_start(c: &Counts) -> Result<u64, CliError> {
+    match c.first_emg {
+        None => Err(CliError::Usage(
+            "no EMG_SAMPLES frame was recorded, so the trials cannot be placed on the \
+             recording: is handsim (or the amplifier) running on this interface?"
+                .into(),
+        )),
+        Some((t, 0)) => Ok(t),
+        Some((_, n)) => Err(CliError::Usage(format!(
+            "the first EMG sample recorded has counter {n}, not 0: the recording started after \
+             handsim's scenario, so the trial times cannot be placed; start handctl record \
+             before handsim"
+        ))),
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TrialsFile {
+    trial: Vec<CalibrationTrial>,
+}
+
+fn read_trials(path: &Path) -> Result<Vec<CalibrationTrial>, CliError> {
+    let text = std::fs::read_to_string(path).map_err(io_err(path))?;
+    let f: TrialsFile = toml::from_str(&text).map_err(|e| {
+        CliError::Usage(format!(
+            "{}: not a trials file as handsim --trials-out writes it: {e}",
+            path.display()
+        ))
+    })?;
+    if f.trial.is_empty() {
+        return Err(CliError::Usage(format!(
+            "{}: holds no trials (record a calibration scenario)",
+            path.display()
+        )));
+    }
+    Ok(f.trial)
+}
+
+#[derive(Serialize)]
+struct SessionDoc<'a> {
+    format_version: u32,
+    onset_skip_ms: f64,
+    chain: ChainDoc,
+    recording: RecordingDoc,
+    trial: &'a [CalibrationTrial],
+}
+
+#[derive(Serialize)]
+struct ChainDoc {
+    channels: usize,
+    sample_rate_hz: f64,
+    mains_hz: u32,
+}
+
+#[derive(Serialize)]
+struct RecordingDoc {
+    format: &'static str,
+    file: &'static str,
+    full_scale: f64,
+}
+
+fn session_toml(
+    trials: &[CalibrationTrial],
+    start_us: u64,
+    mains_hz: u32,
+) -> Result<String, CliError> {
+    let shifted: Vec<CalibrationTrial> = trials
+        .iter()
+        .map(|t| CalibrationTrial {
+            start_us: t.start_us + start_us,
+            end_us: t.end_us + start_us,
+            ..*t
+        })
+        .collect();
+    let doc = SessionDoc {
+        format_version: decoder::session::FORMAT_VERSION,
+        onset_skip_ms: 0.0,
+        chain: ChainDoc {
+            channels: N_CHANNELS,
+            sample_rate_hz: 1000.0,
+            mains_hz,
+        },
+        recording: RecordingDoc {
+            format: "candump",
+            file: FRAMES_FILE,
+            full_scale: f64::from(ADC_MAX),
+        },
+        trial: &shifted,
+    };
+    toml::to_string(&doc).map_err(|e| CliError::Usage(format!("cannot write session.toml: {e}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn trials_are_shifted_onto_the_log_time_base() {
+        let t = CalibrationTrial {
+            id: 1,
+            finger: Some(1),
+            kind: hand_model::patient::TrialKind::Flexion,
+            start_us: 1_000,
+            end_us: 2_000,
+            repetition: 1,
+        };
+        let text = session_toml(&[t], 1_700_000_000_000_000, 50).expect("serialises");
+        let meta = decoder::session::SessionMeta::parse(&text, Path::new("session.toml"))
+            .expect("decoder reads what the recorder writes");
+        assert_eq!(meta.trials.len(), 1);
+        assert_eq!(meta.trials[0].start_us, 1_700_000_000_001_000);
+        assert_eq!(meta.trials[0].end_us, 1_700_000_000_002_000);
+    }
+
+    #[test]
+    fn a_late_start_is_refused_with_the_reason() {
+        let c = Counts {
+            first_emg: Some((5, 17)),
+            ..Counts::default()
+        };
+        let msg = scenario_start(&c).expect_err("late start").to_string();
+        assert!(msg.contains("before handsim"), "{msg}");
+        let none = scenario_start(&Counts::default())
+            .expect_err("no EMG")
+            .to_string();
+        assert!(none.contains("no EMG_SAMPLES"), "{none}");
+        assert_eq!(
+            scenario_start(&Counts {
+                first_emg: Some((42, 0)),
+                ..Counts::default()
+            })
+            .expect("counter 0"),
+            42
+        );
+    }
+}

@@ -1,0 +1,125 @@
+//! A bus monitor: a raw CAN socket in its own thread, every frame kept with its kernel receive
+//! time (µs since the Unix epoch, the same base as `handctl record`'s log).
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::thread::JoinHandle;
+use std::time::{Duration, UNIX_EPOCH};
+
+use hand_dbc::CanFrame;
+use socketcan::{CanSocket, EmbeddedFrame, Socket, SocketOptions};
+
+/// One frame the monitor saw.
+#[derive(Debug, Clone)]
+pub struct Seen {
+    /// Kernel receive time, µs since the Unix epoch.
+    pub time_us: u64,
+    /// The data frame (None for an error frame).
+    pub frame: Option<CanFrame>,
+}
+
+/// A running monitor.
+#[derive(Debug)]
+pub struct Monitor {
+    seen: Arc<Mutex<Vec<Seen>>>,
+    stop: Arc<AtomicBool>,
+    thread: Option<JoinHandle<()>>,
+}
+
+/// Kernel receive time of a socketcan timestamp, µs since the epoch.
+pub fn epoch_us(t: std::time::SystemTime) -> u64 {
+    t.duration_since(UNIX_EPOCH)
+        .map(|d| d.as_micros() as u64)
+        .unwrap_or(0)
+}
+
+/// The wall clock now, µs since the epoch (the base of kernel timestamps).
+pub fn now_us() -> u64 {
+    epoch_us(std::time::SystemTime::now())
+}
+
+impl Monitor {
+    /// Starts watching `iface`. The monitor keeps reading across `ip link set down/up`.
+    pub fn start(iface: &str) -> Self {
+        let seen = Arc::new(Mutex::new(Vec::with_capacity(1 << 16)));
+        let stop = Arc::new(AtomicBool::new(false));
+        let sock = open(iface);
+        let (s2, st2, name) = (Arc::clone(&seen), Arc::clone(&stop), iface.to_owned());
+        let thread = std::thread::spawn(move || {
+            let mut sock = Some(sock);
+            while !st2.load(Ordering::Relaxed) {
+                let Some(s) = &sock else {
+                    std::thread::sleep(Duration::from_millis(5));
+                    sock = try_open(&name);
+                    continue;
+                };
+                match s.read_frame_with_timestamp() {
+                    Ok((f, ts)) => {
+                        let frame = match f {
+                            socketcan::CanFrame::Data(d) => CanFrame::new(d.id(), d.data()),
+                            socketcan::CanFrame::Remote(r) => CanFrame::new_remote(r.id(), r.dlc()),
+                            socketcan::CanFrame::Error(_) => None,
+                        };
+                        let mut v = s2.lock().unwrap_or_else(|e| e.into_inner());
+                        v.push(Seen {
+                            time_us: epoch_us(ts),
+                            frame,
+                        });
+                    }
+                    Err(e)
+                        if matches!(
+                            e.kind(),
+                            std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                        ) => {}
+                    // The interface went down: reopen when it is back.
+                    Err(_) => sock = None,
+                }
+            }
+        });
+        Self {
+            seen,
+            stop,
+            thread: Some(thread),
+        }
+    }
+
+    /// A copy of everything seen so far.
+    pub fn snapshot(&self) -> Vec<Seen> {
+        self.seen.lock().unwrap_or_else(|e| e.into_inner()).clone()
+    }
+
+    /// Stops the thread and returns everything seen.
+    pub fn finish(mut self) -> Vec<Seen> {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            t.join().expect("monitor thread");
+        }
+        self.snapshot()
+    }
+}
+
+impl Drop for Monitor {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+fn try_open(iface: &str) -> Option<CanSocket> {
+    let s = CanSocket::open(iface).ok()?;
+    s.set_recv_timestamp(true).ok()?;
+    s.set_error_filter_accept_all().ok()?;
+    s.set_read_timeout(Duration::from_millis(20)).ok()?;
+    Some(s)
+}
+
+fn open(iface: &str) -> CanSocket {
+    try_open(iface).unwrap_or_else(|| panic!("monitor: cannot open a CAN socket on {iface:?}"))
+}
+
+/// A socket for writing test frames (floods, error frames) on `iface`.
+pub fn writer(iface: &str) -> CanSocket {
+    CanSocket::open(iface).unwrap_or_else(|e| panic!("cannot open {iface:?} for writing: {e}"))
+}

@@ -1,0 +1,192 @@
+//! The project's binaries as child processes: started with their output in files of the test's
+//! scratch directory (shown when a test fails), killed when dropped.
+
+use std::fs::File;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use super::env::VcanEnv;
+
+/// A running child process, SIGKILLed on drop if still running.
+#[derive(Debug)]
+pub struct Proc {
+    name: String,
+    child: Child,
+    log: PathBuf,
+}
+
+impl Proc {
+    /// Starts `bin` with `args`; stdout and stderr go to `dir/<name>.log`.
+    pub fn spawn(env: &VcanEnv, bin: &str, name: &str, args: &[String], dir: &Path) -> Self {
+        let log = dir.join(format!("{name}.log"));
+        let out = File::create(&log).expect("log file in the scratch directory");
+        let err = out.try_clone().expect("log file handle");
+        let child = Command::new(env.bin(bin))
+            .args(args)
+            .stdin(Stdio::null())
+            .stdout(out)
+            .stderr(err)
+            .spawn()
+            .unwrap_or_else(|e| panic!("cannot start {}: {e}", env.bin(bin).display()));
+        Self {
+            name: name.to_owned(),
+            child,
+            log,
+        }
+    }
+
+    /// The process id.
+    pub fn pid(&self) -> u32 {
+        self.child.id()
+    }
+
+    /// What the process wrote so far.
+    pub fn output(&self) -> String {
+        std::fs::read_to_string(&self.log).unwrap_or_default()
+    }
+
+    /// Whether it is still running.
+    pub fn running(&mut self) -> bool {
+        matches!(self.child.try_wait(), Ok(None))
+    }
+
+    /// SIGKILL, then reap.
+    pub fn kill(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+
+    /// Waits up to `limit` for the process to end by itself and asserts it exited with 0.
+    pub fn wait_success(&mut self, limit: Duration) {
+        let end = Instant::now() + limit;
+        loop {
+            match self.child.try_wait() {
+                Ok(Some(st)) => {
+                    assert!(
+                        st.success(),
+                        "{} ended with {st}; its output:\n{}",
+                        self.name,
+                        self.output()
+                    );
+                    return;
+                }
+                Ok(None) if Instant::now() < end => std::thread::sleep(Duration::from_millis(20)),
+                Ok(None) => {
+                    self.kill();
+                    panic!(
+                        "{} did not end within {limit:?}; its output:\n{}",
+                        self.name,
+                        self.output()
+                    );
+                }
+                Err(e) => panic!("waiting for {}: {e}", self.name),
+            }
+        }
+    }
+}
+
+impl Drop for Proc {
+    fn drop(&mut self) {
+        if self.running() {
+            self.kill();
+        }
+    }
+}
+
+/// Runs `handctl ARGS` to completion; panics with its output unless it succeeds.
+pub fn handctl(env: &VcanEnv, args: &[&str]) -> Output {
+    let out = Command::new(env.bin("handctl"))
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run handctl: {e}"));
+    assert!(
+        out.status.success(),
+        "handctl {} failed ({}):\n{}{}",
+        args.join(" "),
+        out.status,
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// A handd config file for one test.
+#[derive(Debug, Clone)]
+pub struct TestConfig {
+    /// The config file.
+    pub path: PathBuf,
+    /// handd's control socket.
+    pub socket: PathBuf,
+}
+
+impl TestConfig {
+    /// Writes `dir/handd.toml` for `model` on the env's interface; `silence_ms` sets both the
+    /// EMG and the finger silence timeouts.
+    pub fn write(env: &VcanEnv, dir: &Path, model: &Path, silence_ms: u32) -> Self {
+        let path = dir.join("handd.toml");
+        let socket = dir.join("handctl.sock");
+        let text = format!(
+            "interface = \"{}\"\nmodel = \"{}\"\ntick_ms = 50\nmains_hz = 50\n\n\
+             [timeouts]\nemg_silence_ms = {silence_ms}\nfinger_silence_ms = {silence_ms}\n\
+             recovery_ms = 500\n\n[control]\nsocket = \"{}\"\ngroup = \"root\"\n\
+             audit_log = \"{}\"\n",
+            env.iface,
+            model.display(),
+            socket.display(),
+            dir.join("audit.log").display()
+        );
+        std::fs::write(&path, text).expect("config in the scratch directory");
+        Self { path, socket }
+    }
+
+    /// Starts handd with this config.
+    pub fn start(&self, env: &VcanEnv, dir: &Path) -> Proc {
+        let args = vec!["--config".to_string(), self.path.display().to_string()];
+        let p = Proc::spawn(env, "handd", "handd", &args, dir);
+        // handd is up once its control socket exists.
+        let end = Instant::now() + Duration::from_secs(20);
+        while !self.socket.exists() {
+            assert!(
+                Instant::now() < end,
+                "handd did not open its control socket; its output:\n{}",
+                p.output()
+            );
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        p
+    }
+
+    /// `handctl status --json` against this daemon.
+    pub fn status(&self, env: &VcanEnv) -> driver::protocol::Status {
+        let sock = self.socket.display().to_string();
+        let out = handctl(env, &["status", "--json", "--socket", &sock]);
+        serde_json::from_slice(&out.stdout).unwrap_or_else(|e| {
+            panic!(
+                "handctl status --json is not a status ({e}):\n{}",
+                String::from_utf8_lossy(&out.stdout)
+            )
+        })
+    }
+}
+
+/// Starts handsim on the env's interface with `scenario` for `seconds`, plus extra arguments.
+pub fn handsim(
+    env: &VcanEnv,
+    dir: &Path,
+    name: &str,
+    scenario: &str,
+    seconds: f64,
+    extra: &[&str],
+) -> Proc {
+    let mut args = vec![
+        "--iface".to_string(),
+        env.iface.clone(),
+        "--scenario".into(),
+        scenario.into(),
+        "--duration".into(),
+        format!("{seconds}"),
+    ];
+    args.extend(extra.iter().map(|s| s.to_string()));
+    Proc::spawn(env, "handsim", name, &args, dir)
+}

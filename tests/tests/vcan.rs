@@ -1,0 +1,565 @@
+//! The vcan suite: handd, handsim and handctl as separate processes on a real SocketCAN
+//! interface (the kernel's vcan), as they run in the prosthesis. Run it with
+//! `./scripts/vm/run` (in a VM whose kernel has vcan, or directly where vcan0 exists); the
+//! tests share the bus, so they run one at a time (`--test-threads=1`).
+//!
+//! Times are kernel receive timestamps of a monitor socket; handsim's scenario time 0 is the
+//! receive time of its first EMG sample (counter 0), so fault onsets are placed on the bus.
+
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use std::time::{Duration, Instant};
+
+use hand_dbc::messages::{FingerMode, FingerState};
+use hand_model::patient::{Target, TrackingConfig};
+use handstack_tests::vcan::monitor::{now_us, writer};
+use handstack_tests::vcan::procs::{handctl, handsim};
+use handstack_tests::vcan::{
+    first_safe_stop_after, scenario_start_us, setpoints_of, statuses_of, Monitor, Proc, TestConfig,
+    VcanEnv,
+};
+use socketcan::{EmbeddedFrame, Socket};
+
+/// The daemon's safe-stop bar: setpoints on the bus at most this long after a fault's onset.
+const SAFE_STOP_BAR_US: u64 = 100_000;
+/// Silence timeouts of the drills: 40 ms detection + at most one 50 ms tick stays within the
+/// 100 ms bar (the default 100 ms timeout alone would use the whole bar).
+const DRILL_SILENCE_MS: u32 = 40;
+
+static MODEL: OnceLock<PathBuf> = OnceLock::new();
+
+/// Calibration over the bus: handsim plays the quick calibration, `handctl record` records it
+/// into a session, `handctl train` fits ResDD. Done once; later tests reuse the model.
+fn calibrated_model(env: &VcanEnv) -> &'static Path {
+    MODEL.get_or_init(|| {
+        let dir = env.scratch("calibration");
+        let trials = dir.join("trials.toml");
+        // The trials file first (the in-memory run writes it and stops at once), so the
+        // recorder can check it before the recording starts.
+        let mut t = Proc::spawn(
+            env,
+            "handsim",
+            "handsim-trials",
+            &[
+                "--mem".into(),
+                "--scenario".into(),
+                "calibration-quick".into(),
+                "--duration".into(),
+                "0.001".into(),
+                "--trials-out".into(),
+                trials.display().to_string(),
+            ],
+            &dir,
+        );
+        t.wait_success(Duration::from_secs(30));
+        let session = dir.join("session");
+        let mut rec = Proc::spawn(
+            env,
+            "handctl",
+            "record",
+            &[
+                "record".into(),
+                "--iface".into(),
+                env.iface.clone(),
+                "--out".into(),
+                session.display().to_string(),
+                "--duration".into(),
+                "15.5".into(),
+                "--trials".into(),
+                trials.display().to_string(),
+            ],
+            &dir,
+        );
+        std::thread::sleep(Duration::from_millis(500));
+        let mut sim = handsim(env, &dir, "handsim", "calibration-quick", 14.0, &[]);
+        sim.wait_success(Duration::from_secs(60));
+        rec.wait_success(Duration::from_secs(60));
+        println!("record: {}", rec.output().trim());
+        let model = dir.join("model.hsm");
+        let out = handctl(
+            env,
+            &[
+                "train",
+                &session.display().to_string(),
+                "-o",
+                &model.display().to_string(),
+                "--validation",
+                "trial-tail",
+            ],
+        );
+        println!("train: {}", String::from_utf8_lossy(&out.stdout).trim());
+        model
+    })
+}
+
+#[test]
+fn a_calibration_recorded_from_the_bus_trains_resdd() {
+    let env = VcanEnv::get();
+    let model = calibrated_model(&env);
+    let s = decoder::session::Session::open(&model.parent().expect("dir").join("session"))
+        .expect("the recorded session opens");
+    assert_eq!(s.meta.trials.len(), 13, "calibration-quick has 13 trials");
+    let report = decoder::session::check_gates(&s, &decoder::session::GateConfig::default())
+        .expect("gates run");
+    assert!(report.passed(), "quality gates:\n{report}");
+    let dir = env.scratch("check");
+    let cfg = TestConfig::write(&env, &dir, model, 100);
+    let out = std::process::Command::new(env.bin("handd"))
+        .args(["--check", "--config", &cfg.path.display().to_string()])
+        .output()
+        .expect("handd runs");
+    assert!(
+        out.status.success(),
+        "handd --check refused the trained model: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// handd with the trained model, handsim running its full world with `scenario`.
+struct Rig {
+    env: VcanEnv,
+    dir: PathBuf,
+    cfg: TestConfig,
+    handd: Proc,
+    monitor: Monitor,
+}
+
+impl Rig {
+    fn start(name: &str, silence_ms: u32) -> Self {
+        let env = VcanEnv::get();
+        let model = calibrated_model(&env).to_path_buf();
+        let dir = env.scratch(name);
+        let cfg = TestConfig::write(&env, &dir, &model, silence_ms);
+        let monitor = Monitor::start(&env.iface);
+        let handd = cfg.start(&env, &dir);
+        Self {
+            env,
+            dir,
+            cfg,
+            handd,
+            monitor,
+        }
+    }
+
+    fn sim(&self, scenario: &str, seconds: f64, extra: &[&str]) -> Proc {
+        handsim(&self.env, &self.dir, "handsim", scenario, seconds, extra)
+    }
+}
+
+fn active_between(sps: &[handstack_tests::vcan::SetpointRecord], from: u64, to: u64) -> usize {
+    sps.iter()
+        .filter(|s| s.time_us >= from && s.time_us < to && s.mode == FingerMode::Active)
+        .count()
+}
+
+#[test]
+fn b_closed_loop_tracks_a_sine_over_vcan() {
+    let rig = Rig::start("closed-loop", 100);
+    let rec_dir = rig.dir.join("recording");
+    let mut rec = Proc::spawn(
+        &rig.env,
+        "handctl",
+        "record",
+        &[
+            "record".into(),
+            "--iface".into(),
+            rig.env.iface.clone(),
+            "--out".into(),
+            rec_dir.display().to_string(),
+            "--duration".into(),
+            "26".into(),
+        ],
+        &rig.dir,
+    );
+    std::thread::sleep(Duration::from_millis(300));
+    let mut sim = rig.sim("sine", 25.0, &[]);
+    sim.wait_success(Duration::from_secs(90));
+    let status = rig.cfg.status(&rig.env);
+    rec.wait_success(Duration::from_secs(30));
+    let seen = rig.monitor.finish();
+    let start = scenario_start_us(&seen);
+    let tracking = TrackingConfig::default();
+    let settle = 4_000_000;
+    let (mut target, mut tracked) = (Vec::new(), Vec::new());
+    for s in statuses_of(&seen) {
+        if s.finger == tracking.finger && s.time_us >= start + settle {
+            target.push(Target::SINE_4S.at(s.time_us - start));
+            tracked.push(s.force / tracking.full_scale_force_n);
+        }
+    }
+    assert!(
+        target.len() >= 20 * 45,
+        "only {} index FINGER_STATUS frames in 21 s of tracking",
+        target.len()
+    );
+    let m = decoder::eval::tracking_metrics(&target, &tracked).expect("metrics");
+    println!(
+        "closed loop over {}: {} samples, R² {:.3}, RMSE {:.3} (force / full scale), deadline \
+         misses {}, latency p50 {} us p99 {} us",
+        rig.env.iface,
+        target.len(),
+        m.r2,
+        m.rmse,
+        status.deadline_misses,
+        status.latency.p50_us,
+        status.latency.p99_us
+    );
+    assert!(
+        m.r2 >= 0.8,
+        "tracking R² {:.3} < 0.8 (RMSE {:.3})",
+        m.r2,
+        m.rmse
+    );
+    let log =
+        hand_dbc::candump::read_log(rec_dir.join("frames.log")).expect("the recording parses");
+    assert!(log.len() as f64 >= 0.9 * seen.len() as f64 * 25.0 / 26.0);
+}
+
+struct Drill<'a> {
+    name: &'a str,
+    fault: &'a str,
+    /// Fingers that must be stopped (all for a daemon fault, one for a silent controller).
+    fingers: &'a [usize],
+    /// Whether the fault latches (setpoints stay stopped after it ends until `handctl arm`).
+    latched: bool,
+}
+
+const ALL: [usize; 5] = [0, 1, 2, 3, 4];
+const ONSET_US: u64 = 2_500_000;
+const FAULT_END_US: u64 = 3_000_000;
+const RUN_S: f64 = 5.0;
+
+/// Runs one handsim-injected fault and checks time to safe stop and the recovery rule.
+fn drill(d: &Drill<'_>) {
+    let rig = Rig::start(d.name, DRILL_SILENCE_MS);
+    let fault = format!(
+        "{}@{}..{}",
+        d.fault,
+        ONSET_US as f64 * 1e-6,
+        FAULT_END_US as f64 * 1e-6
+    );
+    let mut sim = rig.sim("sine", RUN_S, &["--fault", &fault]);
+    sim.wait_success(Duration::from_secs(60));
+    let seen = rig.monitor.finish();
+    let start = scenario_start_us(&seen);
+    let sps = setpoints_of(&seen);
+    check_stop(
+        d,
+        &sps,
+        start + ONSET_US,
+        start + FAULT_END_US,
+        start + (RUN_S * 1e6) as u64,
+    );
+    drop(rig.handd);
+}
+
+fn check_stop(
+    d: &Drill<'_>,
+    sps: &[handstack_tests::vcan::SetpointRecord],
+    onset: u64,
+    fault_end: u64,
+    end: u64,
+) {
+    assert!(
+        active_between(sps, onset - 500_000, onset) > 0,
+        "{}: handd was not RUNNING before the fault (no ACTIVE setpoints in the 0.5 s before)",
+        d.name
+    );
+    let stop = first_safe_stop_after(sps, onset, d.fingers)
+        .unwrap_or_else(|| panic!("{}: no safe-stop setpoints after the onset", d.name));
+    let dt = stop - onset;
+    println!(
+        "drill {}: safe stop {:.1} ms after onset",
+        d.name,
+        dt as f64 * 1e-3
+    );
+    assert!(
+        dt <= SAFE_STOP_BAR_US,
+        "{}: safe stop {} us after onset (bar 100 ms)",
+        d.name,
+        dt
+    );
+    if d.fingers.len() < 5 {
+        let others: Vec<usize> = ALL
+            .iter()
+            .copied()
+            .filter(|f| !d.fingers.contains(f))
+            .collect();
+        for &f in &others {
+            assert!(
+                sps.iter().any(|s| s.finger == f
+                    && s.time_us > stop
+                    && s.time_us < fault_end
+                    && s.mode == FingerMode::Active),
+                "{}: finger {f} should stay ACTIVE while only {:?} is disabled",
+                d.name,
+                d.fingers
+            );
+        }
+    }
+    // Recovery: transient faults clear 500 ms after the fault ends; latched ones need `arm`.
+    let resumed = sps
+        .iter()
+        .filter(|s| {
+            d.fingers.contains(&s.finger) && s.time_us > stop && s.mode == FingerMode::Active
+        })
+        .map(|s| s.time_us)
+        .next();
+    if d.latched {
+        assert!(
+            resumed.is_none(),
+            "{}: a latched fault cleared without arm (ACTIVE again)",
+            d.name
+        );
+    } else {
+        let r =
+            resumed.unwrap_or_else(|| panic!("{}: never resumed after the fault ended", d.name));
+        println!(
+            "drill {}: ACTIVE again {:.0} ms after the fault ended",
+            d.name,
+            (r.saturating_sub(fault_end)) as f64 * 1e-3
+        );
+        assert!(
+            r >= fault_end && r < end,
+            "{}: resumed at a wrong time",
+            d.name
+        );
+    }
+}
+
+#[test]
+fn d1_amplifier_silence() {
+    drill(&Drill {
+        name: "amp-silence",
+        fault: "amp-silence",
+        fingers: &ALL,
+        latched: false,
+    });
+}
+
+#[test]
+fn d2_corrupted_crc() {
+    drill(&Drill {
+        name: "bad-crc",
+        fault: "bad-crc-emg:1",
+        fingers: &ALL,
+        latched: true,
+    });
+}
+
+#[test]
+fn d3_counter_jump() {
+    drill(&Drill {
+        name: "counter-jump",
+        fault: "counter-jump:50",
+        fingers: &ALL,
+        latched: false,
+    });
+}
+
+#[test]
+fn d4_estop() {
+    drill(&Drill {
+        name: "estop",
+        fault: "estop",
+        fingers: &ALL,
+        latched: true,
+    });
+}
+
+#[test]
+fn d5_finger_controller_silent() {
+    drill(&Drill {
+        name: "motor-silent",
+        fault: "motor-silent:2",
+        fingers: &[2],
+        latched: false,
+    });
+}
+
+#[test]
+fn d6_bus_off_error_frame() {
+    let rig = Rig::start("bus-off", DRILL_SILENCE_MS);
+    let mut sim = rig.sim("sine", RUN_S, &[]);
+    let w = writer(&rig.env.iface);
+    // Wait for the scenario's onset on the bus, then inject CAN_ERR_BUSOFF.
+    let begun = Instant::now();
+    let start = loop {
+        let seen = rig.monitor.snapshot();
+        if seen
+            .iter()
+            .any(|s| s.frame.as_ref().is_some_and(|f| f.raw_id() == 0x100))
+        {
+            break scenario_start_us(&seen);
+        }
+        assert!(
+            begun.elapsed() < Duration::from_secs(10),
+            "handsim never started"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    while now_us() < start + ONSET_US {
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let busoff = socketcan::CanErrorFrame::new_error(0x0040, &[0; 8]).expect("error frame");
+    w.write_frame(&busoff)
+        .expect("vcan accepts an injected error frame");
+    sim.wait_success(Duration::from_secs(60));
+    let seen = rig.monitor.finish();
+    let onset = seen
+        .iter()
+        .find(|s| s.frame.is_none() && s.time_us >= start)
+        .map(|s| s.time_us)
+        .expect("the monitor saw the injected error frame");
+    let sps = setpoints_of(&seen);
+    check_stop(
+        &Drill {
+            name: "bus-off",
+            fault: "",
+            fingers: &ALL,
+            latched: true,
+        },
+        &sps,
+        onset,
+        onset,
+        start + (RUN_S * 1e6) as u64,
+    );
+}
+
+#[test]
+fn d7_interface_down_and_up() {
+    let mut rig = Rig::start("link-down", DRILL_SILENCE_MS);
+    let mut sim = rig.sim("sine", RUN_S, &[]);
+    std::thread::sleep(Duration::from_millis(2_500));
+    let down_at = now_us();
+    rig.env.link("down");
+    std::thread::sleep(Duration::from_millis(300));
+    rig.env.link("up");
+    let up_at = now_us();
+    // handsim's sockets error while the link is down; it may end with an error, which is not
+    // what this drill checks.
+    std::thread::sleep(Duration::from_millis(1500));
+    sim.kill();
+    assert!(
+        rig.handd.running(),
+        "handd died when the interface went down:\n{}",
+        rig.handd.output()
+    );
+    let seen = rig.monitor.finish();
+    let sps = setpoints_of(&seen);
+    assert!(
+        active_between(&sps, down_at - 500_000, down_at) > 0,
+        "handd was not RUNNING before"
+    );
+    let after: Vec<_> = sps.iter().filter(|s| s.time_us >= down_at).collect();
+    assert!(
+        !after.is_empty(),
+        "handd sent nothing after the interface came back"
+    );
+    assert!(
+        after
+            .iter()
+            .all(|s| s.mode != FingerMode::Active && s.force == 0.0),
+        "handd sent ACTIVE setpoints after the interface went down (a latched fault)"
+    );
+    let first = after[0].time_us;
+    println!(
+        "drill link-down: nothing on the bus while down; first setpoint (safe stop) {:.1} ms after up",
+        first.saturating_sub(up_at) as f64 * 1e-3
+    );
+    let st = rig.cfg.status(&rig.env);
+    assert_eq!(st.state, "SAFE", "faults: {}", st.faults);
+}
+
+#[test]
+fn e_sigkill_mid_motion_every_controller_brakes() {
+    let mut rig = Rig::start("sigkill", 100);
+    let mut sim = rig.sim("sine", 5.0, &[]);
+    std::thread::sleep(Duration::from_millis(3_000));
+    let kill_at = now_us();
+    rig.handd.kill();
+    sim.wait_success(Duration::from_secs(60));
+    let seen = rig.monitor.finish();
+    let sts = statuses_of(&seen);
+    for f in ALL {
+        assert!(
+            sts.iter().any(|s| s.finger == f
+                && s.time_us < kill_at
+                && s.time_us + 500_000 > kill_at
+                && s.state == FingerState::Active),
+            "finger {f} was not ACTIVE before the kill"
+        );
+        let braked = sts
+            .iter()
+            .find(|s| s.finger == f && s.time_us >= kill_at && s.state == FingerState::Braked)
+            .unwrap_or_else(|| panic!("finger {f} never braked after handd was killed"));
+        let dt = braked.time_us - kill_at;
+        println!(
+            "kill: finger {f} reports BRAKED {:.1} ms after SIGKILL",
+            dt as f64 * 1e-3
+        );
+        // 150 ms watchdog from the last setpoint (sent before the kill), seen in the next
+        // FINGER_STATUS (20 ms period).
+        assert!(
+            dt <= 170_000,
+            "finger {f} braked {dt} us after the kill (150 ms + one status period)"
+        );
+        assert_eq!(braked.force, 0.0, "a braked finger reports zero force");
+    }
+}
+
+#[test]
+fn f_bad_input_flood_keeps_the_deadline() {
+    let rig = Rig::start("flood", 100);
+    let mut sim = rig.sim("sine", 6.0, &[]);
+    let w = writer(&rig.env.iface);
+    std::thread::sleep(Duration::from_millis(2_000));
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(7);
+    let end = Instant::now() + Duration::from_secs(3);
+    let (mut sent, mut refused) = (0u64, 0u64);
+    // 1 Mbit/s of worst-case 8-byte frames is about 7,400 frames/s: send in 1 ms batches of 7.
+    while Instant::now() < end {
+        for _ in 0..7 {
+            let kind = rng.gen_range(0..3);
+            let (id, len) = match kind {
+                0 => (rng.gen_range(0x400..0x7FF), rng.gen_range(0..=8)), // unknown ids
+                1 => (
+                    [0x100u16, 0x180, 0x280, 0x284][rng.gen_range(0..4)],
+                    rng.gen_range(0..4),
+                ), // wrong DLC
+                _ => (0x300 + rng.gen_range(0..2), 8), // random payloads on daemon-only ids
+            };
+            let mut data = [0u8; 8];
+            rng.fill(&mut data[..]);
+            let f = socketcan::CanFrame::new(
+                socketcan::StandardId::new(id).expect("11-bit"),
+                &data[..len],
+            )
+            .expect("frame");
+            match w.write_frame(&f) {
+                Ok(()) => sent += 1,
+                Err(_) => refused += 1,
+            }
+        }
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let st = rig.cfg.status(&rig.env);
+    sim.wait_success(Duration::from_secs(60));
+    assert!(
+        rig.handd.output().find("panicked").is_none(),
+        "handd panicked:\n{}",
+        rig.handd.output()
+    );
+    println!(
+        "flood: {sent} frames sent ({refused} refused by the socket), handd counted {} bad frames, \
+         deadline misses {}, state {}",
+        st.bad_frames, st.deadline_misses, st.state
+    );
+    assert!(st.bad_frames > 0, "handd did not count the bad frames");
+    assert_eq!(
+        st.deadline_misses, 0,
+        "handd missed deadlines under the flood"
+    );
+    drop(rig.monitor);
+}
