@@ -142,7 +142,14 @@ impl TestConfig {
 
     /// Starts handd with this config.
     pub fn start(&self, env: &VcanEnv, dir: &Path) -> Proc {
-        let args = vec!["--config".to_string(), self.path.display().to_string()];
+        // SCHED_FIFO for the control loop, as on the board (root in the VM): the simulated
+        // world shares the CPU with it, and under emulation a normal-priority loop starves.
+        let args = vec![
+            "--config".to_string(),
+            self.path.display().to_string(),
+            "--rt-priority".into(),
+            "50".into(),
+        ];
         let p = Proc::spawn(env, "handd", "handd", &args, dir);
         // handd is up once its control socket exists.
         let end = Instant::now() + Duration::from_secs(20);
