@@ -45,20 +45,7 @@ fn cpu_time_of<R>(iters: u64, mut f: impl FnMut() -> R) -> Duration {
 }
 
 fn summary(kind: ModelKind) -> TrainingSummary {
-    TrainingSummary {
-        kind,
-        config: TrainConfig::default(),
-        epochs_run: 0,
-        best_epoch: 0,
-        stopped_early: false,
-        final_train_loss: 0.0,
-        best_val_loss: None,
-        n_train_windows: 0,
-        n_val_windows: 0,
-        n_train_trials: 0,
-        n_val_trials: 0,
-        duration_ms: 0,
-    }
+    TrainingSummary::untrained(kind)
 }
 
 fn trained_random(kind: ModelKind) -> TrainedModel {

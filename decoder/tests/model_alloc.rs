@@ -6,8 +6,7 @@
 
 use decoder::dsp::ChainConfig;
 use decoder::model::{
-    AnyModel, Model, ModelKind, ModelSpec, Normalizer, TrainConfig, TrainedModel, TrainingSummary,
-    N_FINGERS,
+    AnyModel, Model, ModelKind, ModelSpec, Normalizer, TrainedModel, TrainingSummary, N_FINGERS,
 };
 use stats_alloc::{Region, StatsAlloc, INSTRUMENTED_SYSTEM};
 use std::alloc::System;
@@ -16,20 +15,7 @@ use std::alloc::System;
 static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;
 
 fn summary(kind: ModelKind) -> TrainingSummary {
-    TrainingSummary {
-        kind,
-        config: TrainConfig::default(),
-        epochs_run: 0,
-        best_epoch: 0,
-        stopped_early: false,
-        final_train_loss: 0.0,
-        best_val_loss: None,
-        n_train_windows: 0,
-        n_val_windows: 0,
-        n_train_trials: 0,
-        n_val_trials: 0,
-        duration_ms: 0,
-    }
+    TrainingSummary::untrained(kind)
 }
 
 fn main() {

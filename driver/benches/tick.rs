@@ -15,9 +15,7 @@ use std::time::Duration;
 use cpu_time::ThreadTime;
 use criterion::{criterion_group, criterion_main, Criterion};
 use decoder::dsp::ChainConfig;
-use decoder::model::{
-    AnyModel, ModelKind, ModelSpec, Normalizer, TrainConfig, TrainedModel, TrainingSummary,
-};
+use decoder::model::{AnyModel, ModelKind, ModelSpec, Normalizer, TrainedModel, TrainingSummary};
 use driver::engine::{Engine, EngineSettings};
 use hand_dbc::CanFrame;
 use hand_model::patient::{Intent, Script};
@@ -29,20 +27,7 @@ fn engine() -> Engine {
     let n_in = 8 * chain.channels;
     let spec = ModelSpec::default();
     let model = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, 1).expect("model");
-    let summary = TrainingSummary {
-        kind: ModelKind::ResDd,
-        config: TrainConfig::default(),
-        epochs_run: 0,
-        best_epoch: 0,
-        stopped_early: false,
-        final_train_loss: 0.0,
-        best_val_loss: None,
-        n_train_windows: 0,
-        n_val_windows: 0,
-        n_train_trials: 0,
-        n_val_trials: 0,
-        duration_ms: 0,
-    };
+    let summary = TrainingSummary::untrained(ModelKind::ResDd);
     let norm = Normalizer::from_scales(vec![100.0; n_in]).expect("scales");
     let predictor = TrainedModel::new(model, spec, norm, chain.clone(), summary)
         .expect("model")

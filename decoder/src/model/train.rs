@@ -66,6 +66,27 @@ pub struct TrainingSummary {
     pub duration_ms: u64,
 }
 
+impl TrainingSummary {
+    /// The summary of a model that was never trained (random weights, for tests, benchmarks
+    /// and tools that build a [`TrainedModel`] by hand).
+    pub fn untrained(kind: ModelKind) -> Self {
+        TrainingSummary {
+            kind,
+            config: TrainConfig::default(),
+            epochs_run: 0,
+            best_epoch: 0,
+            stopped_early: false,
+            final_train_loss: 0.0,
+            best_val_loss: None,
+            n_train_windows: 0,
+            n_val_windows: 0,
+            n_train_trials: 0,
+            n_val_trials: 0,
+            duration_ms: 0,
+        }
+    }
+}
+
 /// Masked MSE of `model` over windows `idx` (normalized features in `xn`).
 fn masked_mse(
     model: &AnyModel,

@@ -8,8 +8,7 @@
 
 use decoder::dsp::ChainConfig;
 use decoder::model::{
-    AnyModel, ModelKind, ModelSpec, Normalizer, Predictor, TrainConfig, TrainedModel,
-    TrainingSummary,
+    AnyModel, ModelKind, ModelSpec, Normalizer, Predictor, TrainedModel, TrainingSummary,
 };
 use driver::daemon::Runner;
 use driver::engine::{Engine, EngineSettings};
@@ -28,20 +27,7 @@ pub fn random_predictor(seed: u64) -> Predictor {
     let n_in = 8 * chain.channels;
     let spec = ModelSpec::default();
     let model = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, seed).unwrap();
-    let summary = TrainingSummary {
-        kind: ModelKind::ResDd,
-        config: TrainConfig::default(),
-        epochs_run: 0,
-        best_epoch: 0,
-        stopped_early: false,
-        final_train_loss: 0.0,
-        best_val_loss: None,
-        n_train_windows: 0,
-        n_val_windows: 0,
-        n_train_trials: 0,
-        n_val_trials: 0,
-        duration_ms: 0,
-    };
+    let summary = TrainingSummary::untrained(ModelKind::ResDd);
     // Features are in µV; scale them down so labels stay in a sensible range.
     let norm = Normalizer::from_scales(vec![100.0; n_in]).unwrap();
     TrainedModel::new(model, spec, norm, chain, summary)
