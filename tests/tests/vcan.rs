@@ -27,10 +27,27 @@ const SAFE_STOP_BAR_US: u64 = 100_000;
 const DRILL_SILENCE_MS: u32 = 40;
 
 static MODEL: OnceLock<PathBuf> = OnceLock::new();
+static CALIBRATION_TRIED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+/// The closed loop's handd config and `handctl record` log, for the replay.
+static CLOSED_LOOP: OnceLock<(PathBuf, PathBuf)> = OnceLock::new();
+
+/// The calibration recorded over the bus: scenario, its length (s), the validation split and
+/// the number of trials. The full protocol (3 repetitions, 2 s plateaus, 140 s) is what a
+/// technician records; the quick one (13 trials of 0.5 s, 26 training windows) trains a model
+/// too weak for the closed loop's R² bar (measured 0.71 over vcan).
+const CALIBRATION: (&str, f64, &str, usize) = ("calibration", 140.0, "trial", 39);
 
 /// Calibration over the bus: handsim plays the quick calibration, `handctl record` records it
 /// into a session, `handctl train` fits ResDD. Done once; later tests reuse the model.
 fn calibrated_model(env: &VcanEnv) -> &'static Path {
+    if let Some(m) = MODEL.get() {
+        return m;
+    }
+    // One attempt only: a failed calibration fails every later test at once, not again.
+    assert!(
+        !CALIBRATION_TRIED.swap(true, std::sync::atomic::Ordering::SeqCst),
+        "the calibration over the bus failed in an earlier test (see a_calibration_...)"
+    );
     MODEL.get_or_init(|| {
         let dir = env.scratch("calibration");
         let trials = dir.join("trials.toml");
@@ -43,7 +60,7 @@ fn calibrated_model(env: &VcanEnv) -> &'static Path {
             &[
                 "--mem".into(),
                 "--scenario".into(),
-                "calibration-quick".into(),
+                CALIBRATION.0.into(),
                 "--duration".into(),
                 "0.001".into(),
                 "--trials-out".into(),
@@ -64,16 +81,17 @@ fn calibrated_model(env: &VcanEnv) -> &'static Path {
                 "--out".into(),
                 session.display().to_string(),
                 "--duration".into(),
-                "15.5".into(),
+                format!("{}", CALIBRATION.1 + 1.5),
                 "--trials".into(),
                 trials.display().to_string(),
             ],
             &dir,
         );
         std::thread::sleep(Duration::from_millis(500));
-        let mut sim = handsim(env, &dir, "handsim", "calibration-quick", 14.0, &[]);
-        sim.wait_success(Duration::from_secs(60));
-        rec.wait_success(Duration::from_secs(60));
+        let mut sim = handsim(env, &dir, "handsim", CALIBRATION.0, CALIBRATION.1, &[]);
+        let limit = Duration::from_secs_f64(CALIBRATION.1 + 60.0);
+        sim.wait_success(limit);
+        rec.wait_success(limit);
         println!("record: {}", rec.output().trim());
         let model = dir.join("model.hsm");
         let out = handctl(
@@ -84,7 +102,7 @@ fn calibrated_model(env: &VcanEnv) -> &'static Path {
                 "-o",
                 &model.display().to_string(),
                 "--validation",
-                "trial-tail",
+                CALIBRATION.2,
             ],
         );
         println!("train: {}", String::from_utf8_lossy(&out.stdout).trim());
@@ -98,7 +116,12 @@ fn a_calibration_recorded_from_the_bus_trains_resdd() {
     let model = calibrated_model(&env);
     let s = decoder::session::Session::open(&model.parent().expect("dir").join("session"))
         .expect("the recorded session opens");
-    assert_eq!(s.meta.trials.len(), 13, "calibration-quick has 13 trials");
+    assert_eq!(
+        s.meta.trials.len(),
+        CALIBRATION.3,
+        "trials of {}",
+        CALIBRATION.0
+    );
     let report = decoder::session::check_gates(&s, &decoder::session::GateConfig::default())
         .expect("gates run");
     assert!(report.passed(), "quality gates:\n{report}");
@@ -146,6 +169,19 @@ impl Rig {
     }
 }
 
+/// A rig without its monitor.
+struct RigParts {
+    env: VcanEnv,
+    dir: PathBuf,
+    cfg: TestConfig,
+}
+
+impl RigParts {
+    fn sim(&self, scenario: &str, seconds: f64, extra: &[&str]) -> Proc {
+        handsim(&self.env, &self.dir, "handsim", scenario, seconds, extra)
+    }
+}
+
 fn active_between(sps: &[handstack_tests::vcan::SetpointRecord], from: u64, to: u64) -> usize {
     sps.iter()
         .filter(|s| s.time_us >= from && s.time_us < to && s.mode == FingerMode::Active)
@@ -154,32 +190,95 @@ fn active_between(sps: &[handstack_tests::vcan::SetpointRecord], from: u64, to: 
 
 #[test]
 fn b_closed_loop_tracks_a_sine_over_vcan() {
-    let rig = Rig::start("closed-loop", 100);
-    let rec_dir = rig.dir.join("recording");
+    let env = VcanEnv::get();
+    let model = calibrated_model(&env).to_path_buf();
+    let dir = env.scratch("closed-loop");
+    // The recorder starts first, so the log holds handd's every tick from its first one (the
+    // replay below runs the same engine from the same start). It is the only observer: a
+    // second socket would only load the machine.
+    let rec_dir = dir.join("recording");
     let mut rec = Proc::spawn(
-        &rig.env,
+        &env,
         "handctl",
         "record",
         &[
             "record".into(),
             "--iface".into(),
-            rig.env.iface.clone(),
+            env.iface.clone(),
             "--out".into(),
             rec_dir.display().to_string(),
             "--duration".into(),
-            "26".into(),
+            "27".into(),
         ],
-        &rig.dir,
+        &dir,
     );
+    // can-utils' candump records the same run: an independent recorder to compare with.
+    let candump_bin = env.candump().display().to_string();
+    let mut candump = Proc::spawn(
+        &env,
+        &candump_bin,
+        "candump",
+        &["-L".into(), env.iface.clone()],
+        &dir,
+    );
+    std::thread::sleep(Duration::from_millis(300));
+    let cfg = TestConfig::write(&env, &dir, &model, 100);
+    let _handd = cfg.start(&env, &dir);
+    let rig = RigParts { env, dir, cfg };
     std::thread::sleep(Duration::from_millis(300));
     let mut sim = rig.sim("sine", 25.0, &[]);
     sim.wait_success(Duration::from_secs(90));
     let status = rig.cfg.status(&rig.env);
     rec.wait_success(Duration::from_secs(30));
-    drop(rig.monitor);
     // The analysis reads handctl record's log: the recorder is under test too.
     let log =
         hand_dbc::candump::read_log(rec_dir.join("frames.log")).expect("the recording parses");
+    let _ = CLOSED_LOOP.set((rig.cfg.path.clone(), rec_dir.join("frames.log")));
+    candump.kill();
+    let raw = std::fs::read_to_string(candump.log_path()).expect("candump's output");
+    let theirs = hand_dbc::candump::parse_log(&raw).expect("candump -L output parses");
+    // Both recorders saw the same frames with the same kernel timestamps, in the overlap.
+    let from = theirs[0].time_us.max(log[0].time_us);
+    let to = theirs[theirs.len() - 1]
+        .time_us
+        .min(log[log.len() - 1].time_us);
+    let key =
+        |e: &hand_dbc::candump::LogEntry| (e.time_us, e.frame.raw_id(), e.frame.data().to_vec());
+    let a: Vec<_> = log
+        .iter()
+        .filter(|e| e.time_us >= from && e.time_us <= to)
+        .map(key)
+        .collect();
+    let b: Vec<_> = theirs
+        .iter()
+        .filter(|e| e.time_us >= from && e.time_us <= to)
+        .map(key)
+        .collect();
+    println!(
+        "candump -L and handctl record: {} and {} frames in their common {:.1} s",
+        b.len(),
+        a.len(),
+        (to - from) as f64 * 1e-6
+    );
+    assert!(
+        a.len() > 50_000,
+        "too short an overlap of the two recordings"
+    );
+    assert!(
+        a == b,
+        "candump and handctl record disagree on the frames of the same run"
+    );
+    // For cantools on the host (scripts/vm/run decodes it with hand.dbc): the first 20,000.
+    let mut excerpt = String::new();
+    for line in raw.lines().take(20_000) {
+        excerpt.push_str(line);
+        excerpt.push('\n');
+    }
+    std::fs::write(
+        std::env::temp_dir().join("candump-closed-loop.log"),
+        excerpt,
+    )
+    .expect("candump excerpt in the temp dir");
     let seen: Vec<Seen> = log
         .into_iter()
         .map(|e| Seen {
@@ -545,10 +644,11 @@ fn e_sigkill_mid_motion_every_controller_brakes() {
 
 #[test]
 fn f_bad_input_flood_keeps_the_deadline() {
-    let rig = Rig::start("flood", 100);
+    let mut rig = Rig::start("flood", 100);
     let mut sim = rig.sim("sine", 6.0, &[]);
     let w = writer(&rig.env.iface);
     std::thread::sleep(Duration::from_millis(2_000));
+    let st0 = rig.cfg.status(&rig.env);
     use rand::{Rng, SeedableRng};
     let mut rng = rand::rngs::StdRng::seed_from_u64(7);
     let end = Instant::now() + Duration::from_secs(3);
@@ -586,15 +686,188 @@ fn f_bad_input_flood_keeps_the_deadline() {
         "handd panicked:\n{}",
         rig.handd.output()
     );
+    assert!(
+        rig.handd.running(),
+        "handd died under the flood:\n{}",
+        rig.handd.output()
+    );
+    let misses = st.deadline_misses - st0.deadline_misses;
     println!(
-        "flood: {sent} frames sent ({refused} refused by the socket), handd counted {} bad frames, \
-         deadline misses {}, state {}",
-        st.bad_frames, st.deadline_misses, st.state
+        "flood: {sent} frames in 3 s ({refused} refused by the socket); handd counted {} bad \
+         frames, {misses} deadline misses during the flood ({} since start), state {}",
+        st.bad_frames - st0.bad_frames,
+        st.deadline_misses,
+        st.state
     );
-    assert!(st.bad_frames > 0, "handd did not count the bad frames");
-    assert_eq!(
-        st.deadline_misses, 0,
-        "handd missed deadlines under the flood"
+    assert!(
+        st.bad_frames - st0.bad_frames > 0,
+        "handd did not count the bad frames"
     );
+    assert_eq!(misses, 0, "handd missed deadlines during the flood");
     drop(rig.monitor);
+}
+
+/// Waits until handsim's first EMG sample is on the bus; its receive time (the scenario's 0).
+fn wait_scenario_start(monitor: &Monitor) -> u64 {
+    let begun = Instant::now();
+    loop {
+        let seen = monitor.snapshot();
+        if seen
+            .iter()
+            .any(|s| s.frame.as_ref().is_some_and(|f| f.raw_id() == 0x100))
+        {
+            return scenario_start_us(&seen);
+        }
+        assert!(
+            begun.elapsed() < Duration::from_secs(10),
+            "handsim never started"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+#[test]
+fn c_tuning_kf_live_halves_the_force_within_two_ticks() {
+    let rig = Rig::start("tuning", 100);
+    // gestures: rest 1 s, ramp 0.3 s, then a fist held 2 s (every finger at full flexion).
+    let mut sim = rig.sim("gestures", 3.6, &[]);
+    let start = wait_scenario_start(&rig.monitor);
+    while now_us() < start + 2_200_000 {
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let before_cmd = now_us();
+    let cfg = rig.cfg.path.display().to_string();
+    handctl(
+        &rig.env,
+        &["tune", "--finger", "index", "--kf", "5", "--config", &cfg],
+    );
+    let after_cmd = now_us();
+    sim.wait_success(Duration::from_secs(60));
+    let seen = rig.monitor.finish();
+    let index: Vec<_> = setpoints_of(&seen)
+        .into_iter()
+        .filter(|s| s.finger == 1)
+        .collect();
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    let before: Vec<f64> = index
+        .iter()
+        .filter(|s| s.time_us + 300_000 >= before_cmd && s.time_us < before_cmd)
+        .map(|s| s.force)
+        .collect();
+    // The tick that takes the command and the one after it: two ticks.
+    let after: Vec<_> = index.iter().filter(|s| s.time_us > after_cmd).collect();
+    assert!(
+        before.len() >= 3 && after.len() >= 3,
+        "too few index setpoints around the tune"
+    );
+    let f0 = mean(&before);
+    assert!(
+        f0 > 2.0,
+        "the index finger was not flexing before the tune ({f0:.2} N)"
+    );
+    let second_tick = after[1];
+    let f1 = second_tick.force;
+    let ratio = f1 / f0;
+    // The reported force follows within two ticks of the tune command (slew 400 N/s).
+    let reported = statuses_of(&seen)
+        .into_iter()
+        .filter(|s| s.finger == 1 && s.time_us > second_tick.time_us)
+        .find(|s| s.time_us <= second_tick.time_us + 50_000)
+        .expect("an index FINGER_STATUS within a tick of the new setpoint");
+    println!(
+        "tune: index setpoint {f0:.2} N -> {f1:.2} N (ratio {ratio:.3}, expected 0.5) by the \
+         second tick; controller reports {:.2} N",
+        reported.force
+    );
+    assert!(
+        (ratio - 0.5).abs() < 0.1,
+        "kF 10 -> 5 changed the force by {ratio:.3}"
+    );
+    assert!(
+        (reported.force / f0 - 0.5).abs() < 0.15,
+        "the controller's reported force {:.2} N did not follow the halved setpoint within two \
+         ticks (before {f0:.2} N)",
+        reported.force
+    );
+    let saved = driver::Config::load(&rig.cfg.path).expect("config still valid");
+    assert_eq!(
+        saved.fingers.get(1).kf,
+        5.0,
+        "the config file holds the new kF"
+    );
+}
+
+#[test]
+fn g_replaying_the_recorded_emg_through_the_engine_gives_the_same_setpoints() {
+    let env = VcanEnv::get();
+    let (cfg_path, log_path) = CLOSED_LOOP.get().cloned().unwrap_or_else(|| {
+        b_closed_loop_tracks_a_sine_over_vcan();
+        CLOSED_LOOP
+            .get()
+            .cloned()
+            .expect("the closed loop's recording")
+    });
+    let _ = env;
+    let config = driver::Config::load(&cfg_path).expect("the closed loop's config");
+    let loaded = driver::startup::load_model(&config.model, config.mains_hz).expect("model");
+    let log = hand_dbc::candump::read_log(&log_path).expect("the recording parses");
+    let setpoint_ids = 0x200..=0x204u32;
+    let from_handd = |id: u32| setpoint_ids.contains(&id) || id == 0x300 || id == 0x301;
+    // handd's ticks: each begins with FINGER_SETPOINT_0, followed by the other four.
+    let ticks: Vec<usize> = (0..log.len())
+        .filter(|&i| log[i].frame.raw_id() == 0x200)
+        .collect();
+    assert!(ticks.len() > 400, "only {} ticks recorded", ticks.len());
+    let t_first = log[ticks[0]].time_us;
+    let mut engine = driver::engine::Engine::new(
+        &loaded.chain,
+        loaded.model.predictor(),
+        driver::startup::engine_settings(&config, loaded.model_id),
+        t_first,
+    );
+    engine.validated(t_first);
+    let (mut next_input, mut same, mut different) = (0usize, 0usize, Vec::new());
+    for &i in &ticks {
+        let t = log[i].time_us;
+        while next_input < i {
+            let e = &log[next_input];
+            if !from_handd(e.frame.raw_id()) {
+                engine.on_frame(&e.frame, e.time_us);
+            }
+            next_input += 1;
+        }
+        let recorded: Vec<&hand_dbc::CanFrame> = log[i..]
+            .iter()
+            .filter(|e| setpoint_ids.contains(&e.frame.raw_id()))
+            .take(5)
+            .map(|e| &e.frame)
+            .collect();
+        let replayed: Vec<hand_dbc::CanFrame> = engine
+            .tick(t, t)
+            .iter()
+            .filter(|f| setpoint_ids.contains(&f.raw_id()))
+            .copied()
+            .collect();
+        engine.written(t, 0);
+        let equal = replayed.len() == recorded.len()
+            && replayed
+                .iter()
+                .zip(&recorded)
+                .all(|(a, b)| a.raw_id() == b.raw_id() && a.data() == b.data());
+        if equal {
+            same += 1;
+        } else {
+            different.push(t - t_first);
+        }
+    }
+    println!(
+        "replay: {same} of {} ticks give the recorded setpoint frames bit for bit",
+        ticks.len()
+    );
+    assert!(
+        different.is_empty(),
+        "{} ticks differ, the first at {:?} us after the first tick",
+        different.len(),
+        &different[..different.len().min(5)]
+    );
 }

@@ -49,6 +49,23 @@ impl VcanEnv {
         env
     }
 
+    /// can-utils' candump: next to the project's binaries (the VM) or /usr/bin (Debian's
+    /// can-utils); a clear panic if neither has it.
+    pub fn candump(&self) -> PathBuf {
+        [
+            self.bin_dir.join("candump"),
+            PathBuf::from("/usr/bin/candump"),
+        ]
+        .into_iter()
+        .find(|p| p.is_file())
+        .unwrap_or_else(|| {
+            panic!(
+                "vcan suite: candump is missing: install can-utils (sudo apt-get install \
+                     can-utils), or run ./scripts/vm/run, which puts it in the VM"
+            )
+        })
+    }
+
     /// Path of one of the project's binaries.
     pub fn bin(&self, name: &str) -> PathBuf {
         self.bin_dir.join(name)

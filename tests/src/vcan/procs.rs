@@ -17,18 +17,24 @@ pub struct Proc {
 }
 
 impl Proc {
-    /// Starts `bin` with `args`; stdout and stderr go to `dir/<name>.log`.
+    /// Starts `bin` (one of the project's binaries, or an absolute path) with `args`; stdout
+    /// and stderr go to `dir/<name>.log`.
     pub fn spawn(env: &VcanEnv, bin: &str, name: &str, args: &[String], dir: &Path) -> Self {
         let log = dir.join(format!("{name}.log"));
         let out = File::create(&log).expect("log file in the scratch directory");
         let err = out.try_clone().expect("log file handle");
-        let child = Command::new(env.bin(bin))
+        let path = if bin.starts_with('/') {
+            PathBuf::from(bin)
+        } else {
+            env.bin(bin)
+        };
+        let child = Command::new(&path)
             .args(args)
             .stdin(Stdio::null())
             .stdout(out)
             .stderr(err)
             .spawn()
-            .unwrap_or_else(|e| panic!("cannot start {}: {e}", env.bin(bin).display()));
+            .unwrap_or_else(|e| panic!("cannot start {}: {e}", path.display()));
         Self {
             name: name.to_owned(),
             child,
@@ -39,6 +45,11 @@ impl Proc {
     /// The process id.
     pub fn pid(&self) -> u32 {
         self.child.id()
+    }
+
+    /// Its output file.
+    pub fn log_path(&self) -> &Path {
+        &self.log
     }
 
     /// What the process wrote so far.
@@ -148,7 +159,7 @@ impl TestConfig {
             "--config".to_string(),
             self.path.display().to_string(),
             "--rt-priority".into(),
-            "50".into(),
+            HANDD_FIFO.to_string(),
         ];
         let p = Proc::spawn(env, "handd", "handd", &args, dir);
         // handd is up once its control socket exists.
@@ -195,5 +206,23 @@ pub fn handsim(
         format!("{seconds}"),
     ];
     args.extend(extra.iter().map(|s| s.to_string()));
-    Proc::spawn(env, "handsim", name, &args, dir)
+    // The simulated nodes are the prosthesis's other microcontrollers: they must not stall
+    // behind the test's own threads. A child inherits the scheduling policy of the thread that
+    // starts it, so start handsim from a thread on SCHED_FIFO just below handd's.
+    let (env, name, dir) = (env.clone(), name.to_owned(), dir.to_path_buf());
+    std::thread::spawn(move || {
+        let mut rt = driver::rt::RtReport::default();
+        driver::rt::set_fifo(HANDSIM_FIFO, &mut rt);
+        for w in &rt.warnings {
+            eprintln!("handsim starter: {w}");
+        }
+        Proc::spawn(&env, "handsim", &name, &args, &dir)
+    })
+    .join()
+    .expect("handsim starter thread")
 }
+
+/// SCHED_FIFO priority of handsim (handd's control loop runs at [`HANDD_FIFO`]).
+pub const HANDSIM_FIFO: u8 = 40;
+/// SCHED_FIFO priority of handd's control loop in the suite, as on the board.
+pub const HANDD_FIFO: u8 = 50;
