@@ -242,31 +242,32 @@ fn b_closed_loop_tracks_a_sine_over_vcan() {
     let to = theirs[theirs.len() - 1]
         .time_us
         .min(log[log.len() - 1].time_us);
-    let key =
-        |e: &hand_dbc::candump::LogEntry| (e.time_us, e.frame.raw_id(), e.frame.data().to_vec());
-    let a: Vec<_> = log
+    let key = |e: &hand_dbc::candump::LogEntry| (e.frame.raw_id(), e.frame.data().to_vec());
+    // candump's frames well inside the overlap, and the same stretch of ours: aligned on the
+    // first of candump's frames (by content, within 1 ms), then compared frame by frame.
+    let cd: Vec<_> = theirs
         .iter()
-        .filter(|e| e.time_us >= from && e.time_us <= to)
-        .map(key)
+        .filter(|e| e.time_us >= from + 100_000 && e.time_us + 100_000 <= to)
         .collect();
-    let b: Vec<_> = theirs
+    let first = cd.first().expect("candump's log is not empty");
+    let at = log
         .iter()
-        .filter(|e| e.time_us >= from && e.time_us <= to)
-        .map(key)
-        .collect();
+        .position(|e| key(e) == key(first) && e.time_us.abs_diff(first.time_us) <= 1_000)
+        .expect("candump's first frame is in handctl record's log");
+    let ours: Vec<_> = log.iter().skip(at).take(cd.len()).collect();
+    let same_frames = ours.len() == cd.len() && ours.iter().zip(&cd).all(|(a, b)| key(a) == key(b));
+    let worst_dt = ours
+        .iter()
+        .zip(&cd)
+        .map(|(a, b)| a.time_us.abs_diff(b.time_us))
+        .max()
+        .unwrap_or(0);
     println!(
-        "candump -L and handctl record: {} and {} frames in their common {:.1} s",
-        b.len(),
-        a.len(),
+        "candump -L and handctl record: {} and {} frames in their common {:.1} s; same frames \
+         in the same order: {same_frames}; largest timestamp difference {worst_dt} us",
+        cd.len(),
+        ours.len(),
         (to - from) as f64 * 1e-6
-    );
-    assert!(
-        a.len() > 50_000,
-        "too short an overlap of the two recordings"
-    );
-    assert!(
-        a == b,
-        "candump and handctl record disagree on the frames of the same run"
     );
     // For cantools on the host (scripts/vm/run decodes it with hand.dbc): the first 20,000.
     let mut excerpt = String::new();
@@ -280,7 +281,7 @@ fn b_closed_loop_tracks_a_sine_over_vcan() {
     )
     .expect("candump excerpt in the temp dir");
     let seen: Vec<Seen> = log
-        .into_iter()
+        .iter()
         .map(|e| Seen {
             time_us: e.time_us,
             frame: Some(e.frame),
@@ -312,6 +313,19 @@ fn b_closed_loop_tracks_a_sine_over_vcan() {
         status.deadline_misses,
         status.latency.p50_us,
         status.latency.p99_us
+    );
+    assert!(
+        ours.len() > 50_000,
+        "too short an overlap of the two recordings"
+    );
+    assert!(
+        same_frames,
+        "candump and handctl record disagree on the frames of the same run"
+    );
+    // Both read a kernel receive timestamp of the same frame, per socket.
+    assert!(
+        worst_dt <= 1_000,
+        "candump and handctl record disagree on timestamps by {worst_dt} us"
     );
     assert!(
         m.r2 >= 0.8,
@@ -819,6 +833,21 @@ fn g_replaying_the_recorded_emg_through_the_engine_gives_the_same_setpoints() {
         .collect();
     assert!(ticks.len() > 400, "only {} ticks recorded", ticks.len());
     let t_first = log[ticks[0]].time_us;
+    let active: Vec<u64> = log
+        .iter()
+        .filter(|e| {
+            setpoint_ids.contains(&e.frame.raw_id())
+                && hand_dbc::messages::FingerSetpoint::decode(e.frame.raw_id(), e.frame.data())
+                    .is_ok_and(|s| s.mode() == FingerMode::Active)
+        })
+        .map(|e| e.time_us)
+        .collect();
+    let running = (
+        *active
+            .first()
+            .expect("no ACTIVE setpoint in the closed loop"),
+        *active.last().expect("no ACTIVE setpoint"),
+    );
     let mut engine = driver::engine::Engine::new(
         &loaded.chain,
         loaded.model.predictor(),
@@ -849,6 +878,12 @@ fn g_replaying_the_recorded_emg_through_the_engine_gives_the_same_setpoints() {
             .copied()
             .collect();
         engine.written(t, 0);
+        // The closed loop proper: from handd's first ACTIVE setpoint to its last. Before it,
+        // the engine's start (handd's clock before its first tick) is not in the log; after
+        // it, handsim has ended and the silence timeout falls between tick and send.
+        if t < running.0 || t > running.1 {
+            continue;
+        }
         let equal = replayed.len() == recorded.len()
             && replayed
                 .iter()
@@ -861,9 +896,12 @@ fn g_replaying_the_recorded_emg_through_the_engine_gives_the_same_setpoints() {
         }
     }
     println!(
-        "replay: {same} of {} ticks give the recorded setpoint frames bit for bit",
-        ticks.len()
+        "replay: {same} of {} ticks of the running closed loop ({:.1} s) give the recorded \
+         setpoint frames bit for bit",
+        same + different.len(),
+        (running.1 - running.0) as f64 * 1e-6
     );
+    assert!(same > 400, "only {same} ticks compared");
     assert!(
         different.is_empty(),
         "{} ticks differ, the first at {:?} us after the first tick",
