@@ -10,7 +10,7 @@
 //! All layers have biases (PyTorch's default), so zero input does not give exactly zero output.
 //! Initialisation: He-uniform before each ReLU, Glorot for the output layer, biases zero.
 
-use super::error::ModelError;
+use super::error::{check_params, ModelError};
 use super::init::SeededRng;
 use super::kind::ModelKind;
 use super::linalg::{axpy, dot, matvec_bias, matvec_t, outer_acc, relu, relu_backward};
@@ -180,19 +180,7 @@ impl Cnn {
         params: Vec<f64>,
     ) -> Result<Self, ModelError> {
         let expected = Self::param_count(&spec, n_in, n_out)?;
-        if params.len() != expected {
-            return Err(ModelError::Shape {
-                what: "CNN parameter vector".into(),
-                expected,
-                found: params.len(),
-            });
-        }
-        if let Some(index) = params.iter().position(|p| !p.is_finite()) {
-            return Err(ModelError::NonFinite {
-                what: "CNN parameters".into(),
-                index,
-            });
-        }
+        check_params("CNN", expected, &params)?;
         Ok(Cnn {
             spec,
             n_in,

@@ -8,7 +8,7 @@
 //! Initialisation: LN Glorot-uniform everywhere; MLP He-uniform before each ReLU, Glorot for the
 //! output layer, biases zero.
 
-use super::error::ModelError;
+use super::error::{check_params, ModelError};
 use super::init::SeededRng;
 use super::kind::ModelKind;
 use super::linalg::{axpy, matvec, matvec_bias, matvec_t, outer_acc, relu, relu_backward};
@@ -116,19 +116,7 @@ impl DenseNet {
     ) -> Result<Self, ModelError> {
         Self::check(kind, n_in, hidden, n_out)?;
         let expected = Self::param_count(kind, n_in, hidden, n_out);
-        if params.len() != expected {
-            return Err(ModelError::Shape {
-                what: format!("{kind} parameter vector"),
-                expected,
-                found: params.len(),
-            });
-        }
-        if let Some(index) = params.iter().position(|p| !p.is_finite()) {
-            return Err(ModelError::NonFinite {
-                what: format!("{kind} parameters"),
-                index,
-            });
-        }
+        check_params(&kind.to_string(), expected, &params)?;
         Ok(DenseNet {
             kind,
             n_in,

@@ -36,6 +36,25 @@ pub enum ModelError {
     EmptyFit,
 }
 
+/// Checks a flat parameter vector of `model` (e.g. "ResDD"): its length and that every value is
+/// finite. Shared by every architecture's `from_params`.
+pub(crate) fn check_params(model: &str, expected: usize, params: &[f64]) -> Result<(), ModelError> {
+    if params.len() != expected {
+        return Err(ModelError::Shape {
+            what: format!("{model} parameter vector"),
+            expected,
+            found: params.len(),
+        });
+    }
+    if let Some(index) = params.iter().position(|p| !p.is_finite()) {
+        return Err(ModelError::NonFinite {
+            what: format!("{model} parameters"),
+            index,
+        });
+    }
+    Ok(())
+}
+
 /// Training could not start or did not converge.
 #[derive(Debug, Error, Clone, PartialEq)]
 pub enum TrainError {

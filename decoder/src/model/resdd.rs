@@ -6,7 +6,7 @@
 //! multiplicative term, so with small `X` the model is close to linear; initialisation keeps
 //! `X` small (see [`ResDd::random`]) so training starts from a near-linear map.
 
-use super::error::ModelError;
+use super::error::{check_params, ModelError};
 use super::init::SeededRng;
 use super::kind::ModelKind;
 use super::linalg::{matvec, matvec_t, outer_acc};
@@ -55,19 +55,7 @@ impl ResDd {
     ) -> Result<Self, ModelError> {
         Self::check(&spec, n_in, n_out)?;
         let expected = Self::param_count(&spec, n_in, n_out);
-        if params.len() != expected {
-            return Err(ModelError::Shape {
-                what: "ResDD parameter vector".into(),
-                expected,
-                found: params.len(),
-            });
-        }
-        if let Some(index) = params.iter().position(|p| !p.is_finite()) {
-            return Err(ModelError::NonFinite {
-                what: "ResDD parameters".into(),
-                index,
-            });
-        }
+        check_params("ResDD", expected, &params)?;
         Ok(ResDd {
             spec,
             n_in,
