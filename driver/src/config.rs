@@ -37,6 +37,8 @@ pub mod limits {
     pub const TICK_MS: (u64, u64) = (10, 100);
     /// EMG silence and finger silence timeouts, ms.
     pub const SILENCE_MS: (u64, u64) = (20, 1000);
+    /// Lateness of a tick's start that still meets its deadline, ms (at most half a tick).
+    pub const DEADLINE_SLACK_MS: (u64, u64) = (1, 50);
     /// Recovery time of transient faults, ms.
     pub const RECOVERY_MS: (u64, u64) = (100, 10_000);
 }
@@ -213,6 +215,9 @@ pub struct Config {
     pub model: PathBuf,
     /// Tick period, ms (50 in the paper).
     pub tick_ms: u64,
+    /// A tick starting more than this after its deadline counts as a deadline miss (and the
+    /// systemd watchdog is not fed for it), ms; at most half of `tick_ms`.
+    pub deadline_slack_ms: u64,
     /// Mains frequency for the notch, Hz: 50 or 60.
     pub mains_hz: u32,
     /// Timeouts.
@@ -229,6 +234,7 @@ impl Default for Config {
             interface: "can0".into(),
             model: PathBuf::from("/var/lib/handstack/model.json"),
             tick_ms: 50,
+            deadline_slack_ms: 5,
             mains_hz: 50,
             timeouts: Timeouts::default(),
             fingers: Fingers::default(),
@@ -298,6 +304,14 @@ impl Config {
             });
         }
         check_u64("tick_ms", self.tick_ms, limits::TICK_MS)?;
+        check_u64(
+            "deadline_slack_ms",
+            self.deadline_slack_ms,
+            (
+                limits::DEADLINE_SLACK_MS.0,
+                limits::DEADLINE_SLACK_MS.1.min(self.tick_ms / 2),
+            ),
+        )?;
         if self.mains_hz != 50 && self.mains_hz != 60 {
             return Err(ConfigError::Invalid {
                 field: "mains_hz".into(),
@@ -444,6 +458,19 @@ mod tests {
         assert!(e.to_string().contains("timeouts.recovery_ms"), "{e}");
         let e = Config::from_toml("interface = \"a b\"\n", Path::new("h.toml")).unwrap_err();
         assert!(e.to_string().contains("interface"), "{e}");
+        // The slack is at most half a tick: a later tick would run into the next one.
+        let e = Config::from_toml(
+            "tick_ms = 20\ndeadline_slack_ms = 11\n",
+            Path::new("h.toml"),
+        )
+        .unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("deadline_slack_ms = 11 is not allowed: 1 to 10"),
+            "{e}"
+        );
+        let c = Config::from_toml("deadline_slack_ms = 20\n", Path::new("h.toml")).unwrap();
+        assert_eq!(c.deadline_slack_ms, 20);
     }
 
     #[test]

@@ -32,6 +32,8 @@ pub struct Snapshot {
     pub latency: Percentiles,
     /// Compute time per tick.
     pub compute: Percentiles,
+    /// How late ticks started after their deadlines.
+    pub lateness: Percentiles,
     /// Raw model labels.
     pub labels: [f64; N_FINGERS],
     /// Setpoints sent.
@@ -54,6 +56,7 @@ impl Default for Snapshot {
             counters: Counters::default(),
             latency: Percentiles::default(),
             compute: Percentiles::default(),
+            lateness: Percentiles::default(),
             labels: [0.0; N_FINGERS],
             setpoints: [Setpoint::default(); N_FINGERS],
             reported_force: [0.0; N_FINGERS],
@@ -67,8 +70,10 @@ impl Default for Snapshot {
 /// The snapshot shared with the control thread.
 pub type SharedSnapshot = Arc<Mutex<Snapshot>>;
 
-/// First and longest wait between attempts to reopen a failed bus, µs.
-pub const REOPEN_BACKOFF_US: (u64, u64) = (100_000, 2_000_000);
+/// First and longest wait between attempts to reopen a failed bus, µs. Short, because the
+/// first frames after a reopen are the safe stops the finger controllers need within 100 ms;
+/// capped at one 50 ms tick, because a failed attempt costs only a check of the interface.
+pub const REOPEN_BACKOFF_US: (u64, u64) = (10_000, 50_000);
 
 /// The loop.
 pub struct Runner<T: Transport, K: Clock> {
@@ -157,20 +162,53 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         }
     }
 
-    fn try_reopen(&mut self, now_us: u64) {
+    /// Reopen the bus if it failed and its backoff is over; true if it was reopened now.
+    fn try_reopen(&mut self, now_us: u64) -> bool {
         if self.bus_ok || now_us < self.next_reopen_us {
-            return;
+            return false;
         }
         match self.transport.reopen() {
             Ok(()) => {
                 tracing::warn!("bus reopened; the daemon stays SAFE until `handctl arm`");
                 self.bus_ok = true;
+                true
             }
             Err(e) => {
                 self.backoff_us = (self.backoff_us * 2).min(REOPEN_BACKOFF_US.1);
                 self.next_reopen_us = now_us + self.backoff_us;
                 tracing::debug!(error = %e, retry_in_us = self.backoff_us, "bus reopen failed");
+                false
             }
+        }
+    }
+
+    /// When the loop must wake next: the next tick, or an earlier reopen attempt.
+    pub fn next_wake_us(&self) -> u64 {
+        if self.bus_ok {
+            self.next_deadline_us
+        } else {
+            self.next_deadline_us.min(self.next_reopen_us)
+        }
+    }
+
+    /// Between ticks: try to reopen a failed bus, and once it is back, send safe stops at
+    /// once instead of waiting for the next tick (the finger controllers brake by themselves
+    /// 150 ms after their last setpoint; this keeps the gap well inside that).
+    pub fn service_bus(&mut self) {
+        let now = self.clock.now_us();
+        if !self.try_reopen(now) {
+            return;
+        }
+        let mut failed = None;
+        for f in self.engine.safe_stop_frames() {
+            if let Err(e) = self.transport.send(f) {
+                failed = Some(e);
+                break;
+            }
+        }
+        if let Some(e) = failed {
+            let now = self.clock.now_us();
+            self.bus_failed(now, &e);
         }
     }
 
@@ -207,7 +245,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         }
         let deadline = self.next_deadline_us;
         let t0 = self.clock.now_us();
-        self.last_tick_on_time = t0 <= deadline + self.tick_us / 10;
+        self.last_tick_on_time = self.engine.on_time(t0, deadline);
         let frames = self.engine.tick(t0, deadline);
         let mut failed = None;
         if self.bus_ok {
@@ -247,6 +285,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             counters: e.counters(),
             latency: e.latency().summary(),
             compute: e.compute().summary(),
+            lateness: e.lateness().summary(),
             labels: *e.labels(),
             setpoints: *e.setpoints(),
             reported_force: *e.reported_force(),
@@ -264,10 +303,13 @@ impl<T: Transport, K: Clock> Runner<T, K> {
     pub fn run_realtime(&mut self, stop: &AtomicBool, mut on_tick: impl FnMut(&Self)) {
         while !stop.load(Ordering::Relaxed) {
             let now = self.clock.now_us();
-            if self.next_deadline_us > now {
-                std::thread::sleep(std::time::Duration::from_micros(
-                    self.next_deadline_us - now,
-                ));
+            let wake = self.next_wake_us();
+            if wake > now {
+                std::thread::sleep(std::time::Duration::from_micros(wake - now));
+            }
+            if self.clock.now_us() < self.next_deadline_us {
+                self.service_bus();
+                continue;
             }
             self.step();
             on_tick(self);

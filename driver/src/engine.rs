@@ -53,6 +53,8 @@ pub struct EngineSettings {
     pub recovery_us: u64,
     /// A gap in the samples longer than this makes the window invalid, µs.
     pub max_gap_us: u64,
+    /// A tick starting later than its deadline plus this is a deadline miss, µs.
+    pub deadline_slack_us: u64,
     /// Per-finger gains.
     pub gains: [FingerGains; N_FINGERS],
     /// Model identity for HAND_HEARTBEAT.
@@ -67,6 +69,7 @@ impl Default for EngineSettings {
             finger_silence_us: 100_000,
             recovery_us: 500_000,
             max_gap_us: 20_000,
+            deadline_slack_us: 5_000,
             gains: [FingerGains::default(); N_FINGERS],
             model_id: 0,
         }
@@ -78,7 +81,7 @@ impl Default for EngineSettings {
 pub struct Counters {
     /// Ticks run.
     pub ticks: u64,
-    /// Ticks that started later than their deadline plus one tenth of a period.
+    /// Ticks that started later than their deadline plus the configured slack.
     pub deadline_misses: u64,
     /// EMG samples lost and bridged.
     pub samples_lost: u64,
@@ -101,7 +104,9 @@ pub enum Command {
     Stop,
 }
 
-/// The engine. See the module docs.
+/// The engine. See the module docs. Cloning it forks the whole state (a replay tries
+/// alternatives on clones).
+#[derive(Clone)]
 pub struct Engine {
     settings: EngineSettings,
     chain: Chain,
@@ -136,6 +141,7 @@ pub struct Engine {
     counters: Counters,
     latency: Histogram,
     compute: Histogram,
+    lateness: Histogram,
     last_latency_us: u64,
     tx: [CanFrame; MAX_TX_PER_TICK],
     tx_len: usize,
@@ -209,6 +215,7 @@ impl Engine {
             counters: Counters::default(),
             latency: Histogram::default(),
             compute: Histogram::default(),
+            lateness: Histogram::default(),
             last_latency_us: 0,
             tx: [CanFrame::new_standard(0, &[]).expect("an empty frame is valid"); MAX_TX_PER_TICK],
             tx_len: 0,
@@ -371,7 +378,9 @@ impl Engine {
     /// order. No allocation.
     pub fn tick(&mut self, now_us: u64, deadline_us: u64) -> &[CanFrame] {
         self.counters.ticks += 1;
-        if now_us > deadline_us + self.settings.tick_us / 10 {
+        let late = now_us.saturating_sub(deadline_us);
+        self.lateness.record(late);
+        if late > self.settings.deadline_slack_us {
             self.counters.deadline_misses += 1;
         }
         let dt_s = self.settings.tick_us as f64 * 1e-6;
@@ -497,6 +506,34 @@ impl Engine {
         &self.tx[..self.tx_len]
     }
 
+    /// Safe-stop setpoints for every finger (DISABLED for a disabled one), E2E-protected, to
+    /// send at once when the bus comes back after a failure rather than at the next tick. Only
+    /// when the outputs are not enabled (a bus failure latches SAFE); otherwise nothing, as the
+    /// next tick carries the running setpoints. No allocation.
+    pub fn safe_stop_frames(&mut self) -> &[CanFrame] {
+        self.tx_len = 0;
+        if self.safety.outputs_enabled() {
+            return &self.tx[..0];
+        }
+        for f in 0..N_FINGERS {
+            self.conditioners[f].reset();
+            self.setpoints[f] = Setpoint::default();
+            let mode = if self.watch.is_disabled(f) {
+                FingerMode::Disabled
+            } else {
+                FingerMode::SafeStop
+            };
+            let frame = FingerSetpoint::new(f, mode, 0.0, 0.0)
+                .ok()
+                .and_then(|m| self.setpoint_tx[f].protect_message(&m).ok());
+            if let Some(frame) = frame {
+                self.tx[self.tx_len] = frame;
+                self.tx_len += 1;
+            }
+        }
+        &self.tx[..self.tx_len]
+    }
+
     /// The tick's frames were written at `written_us`, after `compute_us` of work: record the
     /// latency from the newest sample frame used.
     pub fn written(&mut self, written_us: u64, compute_us: u64) {
@@ -541,6 +578,19 @@ impl Engine {
     /// Compute-time histogram.
     pub fn compute(&self) -> &Histogram {
         &self.compute
+    }
+    /// Feature vectors the chain has produced since start (a replay tells its hypotheses
+    /// apart by it).
+    pub fn vectors_emitted(&self) -> u64 {
+        self.chain.vectors_emitted()
+    }
+    /// How late each tick started after its deadline.
+    pub fn lateness(&self) -> &Histogram {
+        &self.lateness
+    }
+    /// Whether a tick that starts at `now_us` for `deadline_us` is on time.
+    pub fn on_time(&self, now_us: u64, deadline_us: u64) -> bool {
+        now_us <= deadline_us + self.settings.deadline_slack_us
     }
     /// Last setpoints per finger.
     pub fn setpoints(&self) -> &[Setpoint; N_FINGERS] {

@@ -66,6 +66,9 @@ pub struct Status {
     pub latency: Percentiles,
     /// Compute time of the tick.
     pub compute: Percentiles,
+    /// How late ticks started after their deadlines (a miss is beyond the configured slack).
+    #[serde(default)]
+    pub lateness: Percentiles,
     /// Per finger, 0 thumb .. 4 pinky.
     pub fingers: Vec<FingerStatus>,
 }

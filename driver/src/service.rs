@@ -49,6 +49,7 @@ impl ControlHandler {
             bad_frames: s.counters.bad_frames,
             latency: s.latency,
             compute: s.compute,
+            lateness: s.lateness,
             fingers: (0..N_FINGERS)
                 .map(|f| FingerStatus {
                     label: s.setpoints[f].label,

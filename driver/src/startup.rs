@@ -118,6 +118,7 @@ pub fn engine_settings(config: &Config, model_id: u32) -> EngineSettings {
         finger_silence_us: config.timeouts.finger_silence_ms * 1000,
         recovery_us: config.timeouts.recovery_ms * 1000,
         max_gap_us: 20_000,
+        deadline_slack_us: config.deadline_slack_ms * 1000,
         gains: std::array::from_fn::<_, N_FINGERS, _>(|f| config.fingers.get(f).gains()),
         model_id,
     }

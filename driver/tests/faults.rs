@@ -216,8 +216,23 @@ fn bus_off_stops_sending_drops_stale_setpoints_and_comes_back_safe() {
     r.run_until(ONSET + 500_000);
     assert!(r.runner.engine().faults().contains(DFault::BusOff));
     let n_before = r.seen.len();
+    let back = r.clock_now();
     r.bus.set_bus_off(false);
     r.run_until(ONSET + 1_500_000);
+    // Safe stops for every finger once the reopen backoff (at most 50 ms) is over, without
+    // waiting for the next tick.
+    let first = r
+        .stopped_from(back, ONSET + 1_500_000, None)
+        .expect("safe stops after the bus came back");
+    let dt = first - back;
+    println!(
+        "bus back -> safe stops on the bus: {} ms",
+        dt as f64 / 1000.0
+    );
+    assert!(
+        dt <= driver::daemon::REOPEN_BACKOFF_US.1 + 1_000,
+        "{dt} us from the bus coming back to safe stops"
+    );
     let after = r
         .setpoints()
         .into_iter()

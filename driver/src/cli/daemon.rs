@@ -51,7 +51,8 @@ pub fn format_status(s: &Status) -> String {
         "state {}   faults {}\n\
          ticks {}   deadline misses {}   EMG samples lost {}   bad frames {}\n\
          latency (newest sample -> setpoints) p50 {} us  p99 {} us  max {} us\n\
-         compute per tick                     p50 {} us  p99 {} us  max {} us\n\n\
+         compute per tick                     p50 {} us  p99 {} us  max {} us\n\
+         tick start after its deadline        p50 {} us  p99 {} us  max {} us\n\n\
          {:<7} {:>7} {:>9} {:>11} {:>11} {:>7} {:>7}  {}\n",
         s.state,
         s.faults,
@@ -65,6 +66,9 @@ pub fn format_status(s: &Status) -> String {
         s.compute.p50_us,
         s.compute.p99_us,
         s.compute.max_us,
+        s.lateness.p50_us,
+        s.lateness.p99_us,
+        s.lateness.max_us,
         "finger",
         "label",
         "force N",

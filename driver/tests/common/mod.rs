@@ -89,8 +89,11 @@ impl Rig {
             now += 1000;
             self.clock.set_us(now);
             self.world.step(now);
+            // As `Runner::run_realtime`: a tick at its deadline, a reopen attempt between ticks.
             if now >= self.runner.next_deadline_us() {
                 self.runner.step();
+            } else if now >= self.runner.next_wake_us() {
+                self.runner.service_bus();
             }
             while let Some(r) = self.probe.receive_timestamped() {
                 self.seen.push((r.time_us.unwrap_or(now), r.frame));
