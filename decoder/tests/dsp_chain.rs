@@ -254,3 +254,59 @@ fn features_equal_the_formulas_over_the_processed_window() {
         assert_eq!(checked, s.n_windows(1500));
     }
 }
+
+#[test]
+fn features_now_match_the_step_features_and_follow_every_sample() {
+    let ch = 12;
+    let s = settings(ch);
+    let w = s.window_len();
+    let mut chain = Chain::new(&s);
+    // A chain whose step is one sample produces a vector for every window end: what
+    // features_now must give at every sample, not only every step.
+    let one = ChainConfig {
+        channels: ch,
+        step_ms: 1.0,
+        ..ChainConfig::default()
+    }
+    .validate()
+    .expect("valid configuration");
+    let mut every = Chain::new(&one);
+    let close = |a: &[f64], b: &[f64], what: &str| {
+        for (i, (x, y)) in a.iter().zip(b).enumerate() {
+            assert!(
+                (x - y).abs() <= 1e-9 * x.abs().max(1e-12),
+                "{what}: feature {i}: {x} vs {y}"
+            );
+        }
+    };
+    let (mut at_steps, mut between) = (0, 0);
+    for n in 0..1500 {
+        let x = sample(n, ch);
+        let ready = chain.push(&x);
+        every.push(&x);
+        if chain.samples_seen() < w as u64 {
+            continue;
+        }
+        let now = chain.features_now().to_vec();
+        close(every.features(), &now, &format!("sample {n}"));
+        if ready {
+            close(
+                chain.features(),
+                &now,
+                &format!("step vector at sample {n}"),
+            );
+            at_steps += 1;
+        } else {
+            between += 1;
+        }
+    }
+    assert!(at_steps >= 20 && between >= 1000, "{at_steps} {between}");
+    // The window slides with every sample.
+    let before = chain.features_now().to_vec();
+    chain.push(&sample(1500, ch));
+    assert_ne!(
+        before,
+        chain.features_now(),
+        "features_now must follow every sample"
+    );
+}

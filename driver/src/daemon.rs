@@ -10,6 +10,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::Receiver;
 use std::sync::{Arc, Mutex};
 
+use hand_dbc::CanFrame;
 use hand_model::Clock;
 
 use crate::conditioner::{FingerGains, Setpoint};
@@ -88,6 +89,8 @@ pub struct Runner<T: Transport, K: Clock> {
     commands: Option<Receiver<Command>>,
     snapshot: SharedSnapshot,
     last_tick_on_time: bool,
+    /// A frame received after the deadline of the tick that read it, for the next tick.
+    held: Option<(CanFrame, u64)>,
 }
 
 impl<T: Transport, K: Clock> Runner<T, K> {
@@ -106,6 +109,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             commands: None,
             snapshot: Arc::new(Mutex::new(Snapshot::default())),
             last_tick_on_time: true,
+            held: None,
         }
     }
 
@@ -155,6 +159,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         }
         self.engine.raise(now_us, fault);
         self.transport.drop_queued();
+        self.held = None;
         if self.bus_ok {
             self.bus_ok = false;
             self.backoff_us = REOPEN_BACKOFF_US.0;
@@ -212,13 +217,26 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         }
     }
 
-    /// Read every waiting frame into the engine.
-    pub fn drain(&mut self) {
+    /// Read every waiting frame received up to `until_us` (the tick's deadline) into the
+    /// engine. The first frame received after it is held back for the next tick, so what a
+    /// tick computes depends on its deadline alone, not on how late it woke up.
+    pub fn drain(&mut self, until_us: u64) {
         if !self.bus_ok {
             return;
         }
+        if let Some((frame, rx_us)) = self.held {
+            if rx_us > until_us {
+                return;
+            }
+            self.held = None;
+            self.engine.on_frame(&frame, rx_us);
+        }
         loop {
             match self.transport.try_recv() {
+                Ok(Some((frame, rx_us))) if rx_us > until_us => {
+                    self.held = Some((frame, rx_us));
+                    break;
+                }
                 Ok(Some((frame, rx_us))) => self.engine.on_frame(&frame, rx_us),
                 Ok(None) => break,
                 Err(e) => {
@@ -234,19 +252,19 @@ impl<T: Transport, K: Clock> Runner<T, K> {
     /// snapshot, and move the deadline on by one period (absolute, so there is no drift).
     pub fn step(&mut self) {
         let now = self.clock.now_us();
+        let deadline = self.next_deadline_us;
         self.try_reopen(now);
-        self.drain();
+        self.drain(deadline);
         if let Some(rx) = &self.commands {
             while let Ok(cmd) = rx.try_recv() {
-                if let Err(e) = self.engine.command(now, cmd) {
+                if let Err(e) = self.engine.command(deadline, cmd) {
                     tracing::warn!(error = %e, "command refused");
                 }
             }
         }
-        let deadline = self.next_deadline_us;
         let t0 = self.clock.now_us();
         self.last_tick_on_time = self.engine.on_time(t0, deadline);
-        let frames = self.engine.tick(t0, deadline);
+        let frames = self.engine.tick(deadline, t0);
         let mut failed = None;
         if self.bus_ok {
             for f in frames {

@@ -4,7 +4,7 @@
 //! Frames go in with their receive time ([`Engine::on_frame`]): EMG sample frames are checked
 //! (E2E), reassembled by counter and pushed sample by sample through the signal chain; finger
 //! status frames feed the per-finger watchdog; an E-stop latches SAFE. Each tick evaluates the
-//! faults, runs the model on the newest feature vector, conditions the labels and builds one
+//! faults, runs the model on the window ending at the newest sample, conditions the labels and builds one
 //! FINGER_SETPOINT per finger, plus HAND_DIAG every tick and HAND_HEARTBEAT every other tick.
 //!
 //! After construction nothing here allocates (a test counts), returns a `Result` on the tick
@@ -127,11 +127,10 @@ pub struct Engine {
     setpoint_tx: [E2eProtector; N_FINGERS],
     heartbeat_tx: E2eProtector,
     last_emg_us: u64,
-    /// Receive time of the frame that completed the newest feature vector.
-    features_rx_us: Option<u64>,
-    /// Receive time of the newest sample frame the last tick used.
-    used_rx_us: Option<u64>,
-    vectors_used: u64,
+    /// Receive time of the frame that completed the newest sample.
+    newest_rx_us: Option<u64>,
+    /// Samples in (`samples_in`) when the model last ran.
+    samples_used: u64,
     /// Sample index (since start) of the last gap over `max_gap_us`.
     last_gap_at: Option<u64>,
     samples_in: u64,
@@ -204,9 +203,8 @@ impl Engine {
             setpoint_tx: FingerSetpoint::E2E.map(E2eProtector::new),
             heartbeat_tx: E2eProtector::new(HandHeartbeat::E2E),
             last_emg_us: now_us,
-            features_rx_us: None,
-            used_rx_us: None,
-            vectors_used: 0,
+            newest_rx_us: None,
+            samples_used: 0,
             last_gap_at: None,
             samples_in: 0,
             labels: [0.0; N_FINGERS],
@@ -338,7 +336,7 @@ impl Engine {
         let sample = &mut self.sample;
         let samples_in = &mut self.samples_in;
         let last_gap_at = &mut self.last_gap_at;
-        let features_rx_us = &mut self.features_rx_us;
+        let newest_rx_us = &mut self.newest_rx_us;
         let railed = &mut self.railed;
         self.assembler.push(frame, rx_us, &mut |s: &EmgSample| {
             *railed += s
@@ -353,20 +351,20 @@ impl Engine {
                 *v = s.uv(ch);
             }
             *samples_in += 1;
-            if chain.push(sample) {
-                *features_rx_us = Some(s.received_us);
-            }
+            // The step's own vectors are not used: the tick reads the newest window itself.
+            chain.push(sample);
+            *newest_rx_us = Some(s.received_us);
         });
         self.counters.samples_lost = self.assembler.stats().lost_samples;
     }
 
     fn window_valid(&self, now_us: u64) -> bool {
-        let full = self.chain.vectors_emitted() > 0;
+        let full = self.chain.samples_seen() >= self.chain.settings().window_len() as u64;
         let gap_left = self
             .last_gap_at
             .is_none_or(|at| self.samples_in - at >= self.chain.settings().window_len() as u64);
         let fresh = self
-            .features_rx_us
+            .newest_rx_us
             .is_some_and(|t| now_us.saturating_sub(t) <= 2 * self.settings.tick_us);
         // Silence longer than the gap limit is a gap in progress: the window will not be
         // complete, so stop now rather than wait for the silence timeout.
@@ -374,11 +372,15 @@ impl Engine {
         full && gap_left && fresh && flowing && !self.chain.faults().any_in_window()
     }
 
-    /// One tick at `now_us` (`deadline_us` is when it was due). Returns the frames to send, in
-    /// order. No allocation.
-    pub fn tick(&mut self, now_us: u64, deadline_us: u64) -> &[CanFrame] {
+    /// The tick due at `now_us` (its deadline), which actually started at `started_us`.
+    /// Everything the tick decides is at its deadline, from the frames received by then (the
+    /// loop holds later ones back for the next tick): so a late wake-up changes when the
+    /// setpoints leave, never what they are, and a recording of the bus replays exactly.
+    /// `started_us` only counts the lateness. Returns the frames to send, in order. No
+    /// allocation.
+    pub fn tick(&mut self, now_us: u64, started_us: u64) -> &[CanFrame] {
         self.counters.ticks += 1;
-        let late = now_us.saturating_sub(deadline_us);
+        let late = started_us.saturating_sub(now_us);
         self.lateness.record(late);
         if late > self.settings.deadline_slack_us {
             self.counters.deadline_misses += 1;
@@ -410,14 +412,13 @@ impl Engine {
             self.note(t);
         }
 
-        // The model, on a fresh vector only.
-        let emitted = self.chain.vectors_emitted();
-        if valid && emitted != self.vectors_used {
-            self.vectors_used = emitted;
-            let y = self.predictor.run(self.chain.features());
+        // The model, on the window ending at the newest sample, when samples came in since
+        // the last run: the setpoints never wait for the chain's next step.
+        if valid && self.samples_in != self.samples_used {
+            self.samples_used = self.samples_in;
+            let y = self.predictor.run(self.chain.features_now());
             if y.iter().all(|v| v.is_finite()) {
                 self.labels = y;
-                self.used_rx_us = self.features_rx_us;
             } else {
                 self.labels = [0.0; N_FINGERS];
                 let t = self.safety.raise(now_us, Fault::NonFinite);
@@ -538,7 +539,9 @@ impl Engine {
     /// latency from the newest sample frame used.
     pub fn written(&mut self, written_us: u64, compute_us: u64) {
         self.compute.record(compute_us);
-        if let Some(rx) = self.used_rx_us {
+        // From the newest sample the tick had (the one its window ends at when the model ran),
+        // whether or not the model ran: HAND_DIAG then says which samples each tick had.
+        if let Some(rx) = self.newest_rx_us {
             let lat = written_us.saturating_sub(rx);
             self.latency.record(lat);
             self.last_latency_us = lat;
@@ -578,11 +581,6 @@ impl Engine {
     /// Compute-time histogram.
     pub fn compute(&self) -> &Histogram {
         &self.compute
-    }
-    /// Feature vectors the chain has produced since start (a replay tells its hypotheses
-    /// apart by it).
-    pub fn vectors_emitted(&self) -> u64 {
-        self.chain.vectors_emitted()
     }
     /// How late each tick started after its deadline.
     pub fn lateness(&self) -> &Histogram {

@@ -438,6 +438,13 @@ const ALL: [usize; 5] = [0, 1, 2, 3, 4];
 const ONSET_US: u64 = 2_500_000;
 const FAULT_END_US: u64 = 3_000_000;
 const RUN_S: f64 = 5.0;
+/// When a latched drill runs `handctl arm` (scenario time): a second after the fault ended,
+/// when the transient faults the gap left behind (an invalid window) have cleared by
+/// themselves.
+const ARM_US: u64 = 4_000_000;
+/// From `handctl arm` to ACTIVE setpoints again: the next tick, plus the command's way
+/// through handctl and the control socket under emulation.
+const ARM_BAR_US: u64 = 300_000;
 
 /// Runs one handsim-injected fault and checks time to safe stop and the recovery rule.
 fn drill(d: &Drill<'_>) {
@@ -449,6 +456,17 @@ fn drill(d: &Drill<'_>) {
         FAULT_END_US as f64 * 1e-6
     );
     let mut sim = rig.sim("sine", RUN_S, &["--fault", &fault]);
+    // A latched fault stays until a technician arms the daemon again.
+    let armed = d.latched.then(|| {
+        let start = wait_scenario_start(&rig.monitor);
+        while now_us() < start + ARM_US {
+            std::thread::sleep(Duration::from_millis(2));
+        }
+        let at = now_us();
+        let sock = rig.cfg.socket.display().to_string();
+        handctl(&rig.env, &["arm", "--socket", &sock]);
+        at
+    });
     sim.wait_success(Duration::from_secs(60));
     let seen = rig.monitor.finish();
     let start = scenario_start_us(&seen);
@@ -459,6 +477,7 @@ fn drill(d: &Drill<'_>) {
         start + ONSET_US,
         start + FAULT_END_US,
         start + (RUN_S * 1e6) as u64,
+        armed,
     );
     drop(rig.handd);
 }
@@ -469,6 +488,7 @@ fn check_stop(
     onset: u64,
     fault_end: u64,
     end: u64,
+    armed: Option<u64>,
 ) {
     assert!(
         active_between(sps, onset - 500_000, onset) > 0,
@@ -516,10 +536,23 @@ fn check_stop(
         .map(|s| s.time_us)
         .next();
     if d.latched {
+        let armed = armed.expect("a latched drill arms the daemon");
         assert!(
-            resumed.is_none(),
-            "{}: a latched fault cleared without arm (ACTIVE again)",
+            resumed.is_some_and(|r| r >= armed),
+            "{}: a latched fault cleared without arm (ACTIVE again before it, or never after)",
             d.name
+        );
+        let r = resumed.unwrap_or(armed);
+        println!(
+            "drill {}: stays stopped until `handctl arm`; ACTIVE again {:.1} ms after it",
+            d.name,
+            (r - armed) as f64 * 1e-3
+        );
+        assert!(
+            r - armed <= ARM_BAR_US,
+            "{}: ACTIVE {} us after `handctl arm` (bar {ARM_BAR_US})",
+            d.name,
+            r - armed
         );
     } else {
         let r =
@@ -614,6 +647,13 @@ fn d6_bus_off_error_frame() {
     let busoff = socketcan::CanErrorFrame::new_error(0x0040, &[0; 8]).expect("error frame");
     w.write_frame(&busoff)
         .expect("vcan accepts an injected error frame");
+    // Bus-off latches: the hand stays stopped until a technician arms the daemon again.
+    while now_us() < start + ARM_US {
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let armed = now_us();
+    let sock = rig.cfg.socket.display().to_string();
+    handctl(&rig.env, &["arm", "--socket", &sock]);
     sim.wait_success(Duration::from_secs(60));
     let seen = rig.monitor.finish();
     let onset = seen
@@ -630,12 +670,30 @@ fn d6_bus_off_error_frame() {
     // what is queued, reopens after its first backoff and sends safe stops at once, then only
     // safe stops until `handctl arm` (latched). So: nothing leaves between the onset and the
     // reopen, every setpoint after it is a safe stop, and the first within the bar.
-    let after: Vec<_> = sps.iter().filter(|s| s.time_us > onset).collect();
+    let after: Vec<_> = sps
+        .iter()
+        .filter(|s| s.time_us > onset && s.time_us < armed)
+        .collect();
     assert!(
         after
             .iter()
             .all(|s| s.mode != FingerMode::Active && s.force == 0.0),
-        "bus-off: ACTIVE setpoints after the bus-off error frame (the fault must latch)"
+        "bus-off: ACTIVE setpoints after the bus-off error frame before `handctl arm` (the \
+         fault must latch)"
+    );
+    let resumed = sps
+        .iter()
+        .find(|s| s.time_us >= armed && s.mode == FingerMode::Active)
+        .map(|s| s.time_us)
+        .expect("bus-off: never ACTIVE again after `handctl arm`");
+    println!(
+        "drill bus-off: ACTIVE again {:.1} ms after `handctl arm`",
+        (resumed - armed) as f64 * 1e-3
+    );
+    assert!(
+        resumed - armed <= ARM_BAR_US,
+        "bus-off: ACTIVE {} us after `handctl arm` (bar {ARM_BAR_US})",
+        resumed - armed
     );
     let first = after
         .first()
@@ -930,15 +988,13 @@ fn g_replaying_the_recorded_emg_through_the_engine_gives_the_same_setpoints() {
     let ReplayReport {
         same,
         different,
-        early_drains,
-        widest,
+        searched,
         running,
     } = replay(&config, &log);
     println!(
         "replay: {same} of {} ticks of the running closed loop ({:.1} s) give the recorded \
-         setpoint frames bit for bit ({early_drains} of them with handd's drain before the \
-         last frames logged ahead of its setpoints; at most {widest} drain/tick-time \
-         hypotheses carried at once)",
+         setpoint frames bit for bit ({searched} of them at a cut point next to the one \
+         HAND_DIAG points at)",
         same + different.len(),
         (running.1 - running.0) as f64 * 1e-6
     );

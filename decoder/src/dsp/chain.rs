@@ -53,6 +53,8 @@ pub struct Chain {
     block_head: usize,
     until_block: usize,
     features: Vec<f64>,
+    /// Features of the window ending at the newest sample, on request ([`Chain::features_now`]).
+    features_now: Vec<f64>,
     /// The current sample of every channel on its way through the cascade; after it, the
     /// filtered output.
     last_filtered: Vec<f64>,
@@ -89,6 +91,7 @@ impl Chain {
             block_head: 0,
             until_block: step_len,
             features: vec![0.0; settings.n_features()],
+            features_now: vec![0.0; settings.n_features()],
             last_filtered: vec![0.0; n_channels],
             faults: Faults::new(n_channels, window_len),
         }
@@ -108,6 +111,7 @@ impl Chain {
         self.block_head = 0;
         self.until_block = self.step_len;
         self.features.fill(0.0);
+        self.features_now.fill(0.0);
         self.last_filtered.fill(0.0);
         self.faults.clear();
     }
@@ -248,6 +252,24 @@ impl Chain {
     /// order. All zeros until the first window is full.
     pub fn features(&self) -> &[f64] {
         &self.features
+    }
+
+    /// The features of the window that ends at the newest sample, computed now over the whole
+    /// window, whatever the step: for a consumer that reads features at its own times (the
+    /// daemon reads them at each tick, so its setpoints use the newest sample, not one up to
+    /// a step old). Same layout as [`Chain::features`], and equal to it (to rounding) right
+    /// after a vector was produced. Meaningful once [`Chain::samples_seen`] reaches the window
+    /// length (the older part of the window is zeros before). No allocation.
+    pub fn features_now(&mut self) -> &[f64] {
+        let w = self.window_len;
+        for ch in 0..self.n_channels {
+            let start = ch * 2 * w + self.head;
+            features_into(
+                &self.ring[start..start + w],
+                &mut self.features_now[ch * FEATURES_PER_CHANNEL..(ch + 1) * FEATURES_PER_CHANNEL],
+            );
+        }
+        &self.features_now
     }
 
     /// Filtered value (after the notch, before rectification) of each channel for the last
