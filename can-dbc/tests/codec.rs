@@ -127,9 +127,9 @@ fn every_message_round_trips_its_zero_and_by_name_form() {
 
 #[test]
 fn diag_labels_are_checked_and_protected_messages_carry_valid_crc() {
-    let diag = HandDiag::new(250, 0, 3, 1.0, -1.0, 0.05, 0.0, -0.55).expect("in range");
+    let diag = HandDiag::new(250, 0, 3, 1.0, -1.0, 0.05, 0.0, -0.55, 2).expect("in range");
     assert!((diag.label4() + 0.55).abs() < 1e-12);
-    assert!(HandDiag::new(250, 0, 3, 1.05, 0.0, 0.0, 0.0, 0.0).is_err());
+    assert!(HandDiag::new(250, 0, 3, 1.05, 0.0, 0.0, 0.0, 0.0, 0).is_err());
 
     let sp = FingerSetpoint::new(4, FingerMode::SafeStop, 0.0, 0.0).expect("valid");
     let mut tx = E2eProtector::new(sp.e2e());

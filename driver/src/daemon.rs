@@ -1,7 +1,8 @@
-//! The daemon's loop around the [`Engine`]: absolute deadlines every tick, all frames read
-//! between ticks, technicians' commands applied at the tick, the bus's health handled (stop
-//! sending, drop queued frames, reopen with backoff, come back in SAFE), and a status snapshot
-//! published for `handctl status`.
+//! The daemon's loop around the [`Engine`]: absolute deadlines every tick, every frame
+//! received up to a tick's deadline read at that tick (later ones wait for the next, so a late
+//! wake-up never changes what a tick computes), technicians' commands applied at the tick,
+//! the bus's health handled (stop sending, drop queued frames, reopen with backoff and send
+//! safe stops at once, stay SAFE), and a status snapshot published for `handctl status`.
 //!
 //! [`Runner::step`] does one tick at a given time, so tests drive it on a virtual clock;
 //! [`Runner::run_realtime`] sleeps to each absolute deadline on the system clock.

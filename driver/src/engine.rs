@@ -127,8 +127,11 @@ pub struct Engine {
     setpoint_tx: [E2eProtector; N_FINGERS],
     heartbeat_tx: E2eProtector,
     last_emg_us: u64,
-    /// Receive time of the frame that completed the newest sample.
+    /// Receive time of the frame that completed the newest sample, and its bus counter.
     newest_rx_us: Option<u64>,
+    newest_counter: u8,
+    /// The newest sample counter of the last tick written, for HAND_DIAG.
+    last_newest_counter: u8,
     /// Samples in (`samples_in`) when the model last ran.
     samples_used: u64,
     /// Sample index (since start) of the last gap over `max_gap_us`.
@@ -204,6 +207,8 @@ impl Engine {
             heartbeat_tx: E2eProtector::new(HandHeartbeat::E2E),
             last_emg_us: now_us,
             newest_rx_us: None,
+            newest_counter: 0,
+            last_newest_counter: 0,
             samples_used: 0,
             last_gap_at: None,
             samples_in: 0,
@@ -337,6 +342,7 @@ impl Engine {
         let samples_in = &mut self.samples_in;
         let last_gap_at = &mut self.last_gap_at;
         let newest_rx_us = &mut self.newest_rx_us;
+        let newest_counter = &mut self.newest_counter;
         let railed = &mut self.railed;
         self.assembler.push(frame, rx_us, &mut |s: &EmgSample| {
             *railed += s
@@ -354,6 +360,7 @@ impl Engine {
             // The step's own vectors are not used: the tick reads the newest window itself.
             chain.push(sample);
             *newest_rx_us = Some(s.received_us);
+            *newest_counter = s.counter;
         });
         self.counters.samples_lost = self.assembler.stats().lost_samples;
     }
@@ -484,6 +491,7 @@ impl Engine {
             shown(2),
             shown(3),
             shown(4),
+            self.last_newest_counter % 4,
         ) {
             self.tx[self.tx_len] = d.to_frame();
             self.tx_len += 1;
@@ -541,6 +549,7 @@ impl Engine {
         self.compute.record(compute_us);
         // From the newest sample the tick had (the one its window ends at when the model ran),
         // whether or not the model ran: HAND_DIAG then says which samples each tick had.
+        self.last_newest_counter = self.newest_counter;
         if let Some(rx) = self.newest_rx_us {
             let lat = written_us.saturating_sub(rx);
             self.latency.record(lat);

@@ -7,17 +7,19 @@
 //! holds later ones back for the next tick). The deadlines lie on an exact 50 ms grid, whose
 //! phase the log gives to within a fraction of a millisecond (each tick's setpoints leave a
 //! little after its deadline); that phase serves as the tick's time. Which frames a tick had
-//! needs more precision, since every EMG sample moves the window: the tick's HAND_DIAG, one
-//! tick later, carries the time from its newest complete sample to its setpoints written, which
-//! points at that sample's frame to within microseconds. The replay feeds the frames up to the
-//! frame it points at; if that tick's setpoints do not come out bit for bit, it tries the
-//! neighbouring cut points of the last [`CUT_SEARCH_US`] on clones of the engine, nearest
-//! first (a frame may be timestamped microseconds from another under emulation). A tick that
-//! matches at no cut point is a difference.
+//! needs more precision, since every EMG sample moves the window: the next tick's HAND_DIAG
+//! carries the time from the tick's newest complete sample to its setpoints written (which
+//! points at that sample's frames to within a millisecond or so under emulation) and that
+//! sample's counter modulo 4 (which picks the one sample there). The replay feeds the frames
+//! up to that sample's last frame. Should the setpoints not come out bit for bit there, it
+//! tries the other cut points of the last [`CUT_SEARCH_US`], latest first, and counts the tick
+//! as searched; a tick that matches at no cut point is a difference.
 
 use driver::engine::Engine;
 use hand_dbc::candump::LogEntry;
-use hand_dbc::messages::{FingerMode, FingerSetpoint, HandDiag};
+use hand_dbc::messages::{
+    EmgSamplesG0, EmgSamplesG1, EmgSamplesG2, FingerMode, FingerSetpoint, HandDiag,
+};
 use hand_dbc::CanFrame;
 
 /// What a replay found.
@@ -27,7 +29,7 @@ pub struct ReplayReport {
     pub same: usize,
     /// Ticks that match at no cut point, as µs after the first tick.
     pub different: Vec<u64>,
-    /// Matching ticks whose cut point was not the one HAND_DIAG points at.
+    /// Matching ticks whose cut point was not the one HAND_DIAG names.
     pub searched: usize,
     /// The running closed loop: first and last ACTIVE setpoint, µs.
     pub running: (u64, u64),
@@ -35,6 +37,12 @@ pub struct ReplayReport {
 
 /// How far back before a tick's setpoints the replay looks for its cut point, µs.
 pub const CUT_SEARCH_US: u64 = 20_000;
+/// Where HAND_DIAG's latency points, the named sample's frames are looked for this far before
+/// and after, µs: the pointer is early by the time between the daemon's last write and its
+/// clock reading (up to about a millisecond under emulation), and the window is shorter than
+/// four samples, so the counter modulo 4 names one sample in it.
+const POINTER_BEFORE_US: u64 = 300;
+const POINTER_AFTER_US: u64 = 2_500;
 
 const SETPOINT_IDS: std::ops::RangeInclusive<u32> = 0x200..=0x204;
 const HAND_DIAG_ID: u32 = 0x301;
@@ -51,8 +59,9 @@ struct Tick {
     time_us: u64,
     /// Time of the last frame it sent (its setpoints written, to within microseconds).
     written_us: u64,
-    /// TickLatency of its HAND_DIAG (about the tick before).
+    /// TickLatency and NewestSample of its HAND_DIAG (about the tick before).
     latency_us: Option<u64>,
+    newest_mod4: Option<u8>,
 }
 
 /// Replays `log` (a candump log of the bus, handd's frames included) through an engine made
@@ -118,34 +127,24 @@ pub fn replay(config: &driver::Config, log: &[LogEntry]) -> ReplayReport {
         let sure = inputs
             .partition_point(|&k| k < tick.first && log[k].time_us + CUT_SEARCH_US <= t)
             .max(fed);
-        // Where HAND_DIAG points: the newest complete sample's frame.
-        let pointed = ticks
-            .get(j + 1)
-            .and_then(|next| next.latency_us)
-            .map(|lat| tick.written_us.saturating_sub(lat));
-        // Cut points (inputs fed), the pointed one first, then by distance to it (or latest
-        // first without a pointer).
-        let mut cuts: Vec<usize> = (sure..=avail).collect();
-        let time_of_cut = |n: usize| {
-            if n == 0 {
-                0
-            } else {
-                log[inputs[n - 1]].time_us
-            }
-        };
-        match pointed {
-            Some(p) => cuts.sort_by_key(|&n| {
-                // The cut just after the pointed frame: its time is at or after the pointer.
-                let tc = time_of_cut(n);
-                let below = time_of_cut(n.saturating_sub(1).max(sure));
-                if tc >= p && below < p {
-                    0
-                } else {
-                    tc.abs_diff(p) + 1
-                }
-            }),
-            None => cuts.reverse(),
-        }
+        // The cut HAND_DIAG names (just after the last frame of the tick's newest complete
+        // sample), then every other cut point of the window, latest first.
+        let named = ticks.get(j + 1).and_then(|next| {
+            let p = tick.written_us.saturating_sub(next.latency_us?);
+            let c = next.newest_mod4?;
+            let first = (sure..avail).find(|&n| {
+                let e = &log[inputs[n]];
+                e.time_us + POINTER_BEFORE_US >= p && emg_counter(e).is_some_and(|k| k % 4 == c)
+            })?;
+            let counter = emg_counter(&log[inputs[first]]);
+            let last = (first..avail)
+                .take_while(|&n| log[inputs[n]].time_us <= p + POINTER_AFTER_US)
+                .filter(|&n| emg_counter(&log[inputs[n]]) == counter)
+                .last()?;
+            Some(last + 1)
+        });
+        let mut cuts: Vec<usize> = named.into_iter().collect();
+        cuts.extend((sure..=avail).rev().filter(|&n| Some(n) != named));
         let mut base = engine.clone();
         feed(&mut base, &inputs[fed..sure], log);
         let mut chosen: Option<(usize, Engine)> = None;
@@ -209,19 +208,32 @@ fn ticks_of(log: &[LogEntry]) -> Vec<Tick> {
                     .filter(|e| from_handd(e.frame.raw_id()))
             };
             let written_us = own().map(|e| e.time_us).max().unwrap_or(log[first].time_us);
-            let latency_us = own()
+            let diag = own()
                 .find(|e| e.frame.raw_id() == HAND_DIAG_ID)
-                .and_then(|e| HandDiag::decode(e.frame.data()).ok())
-                .map(|d| d.tick_latency() as u64)
-                .filter(|&l| l < u64::from(u16::MAX));
+                .and_then(|e| HandDiag::decode(e.frame.data()).ok());
             Tick {
                 first,
                 time_us: log[first].time_us,
                 written_us,
-                latency_us,
+                latency_us: diag
+                    .as_ref()
+                    .map(|d| u64::from(d.tick_latency()))
+                    .filter(|&l| l < u64::from(u16::MAX)),
+                newest_mod4: diag.map(|d| d.newest_sample()),
             }
         })
         .collect()
+}
+
+/// The sample counter of an EMG_SAMPLES frame.
+fn emg_counter(e: &LogEntry) -> Option<u8> {
+    let d = e.frame.data();
+    match e.frame.raw_id() {
+        0x100 => EmgSamplesG0::decode(d).ok().map(|m| m.counter()),
+        0x101 => EmgSamplesG1::decode(d).ok().map(|m| m.counter()),
+        0x102 => EmgSamplesG2::decode(d).ok().map(|m| m.counter()),
+        _ => None,
+    }
 }
 
 fn feed(e: &mut Engine, inputs: &[usize], log: &[LogEntry]) {
