@@ -124,11 +124,12 @@ pub fn handctl(env: &VcanEnv, args: &[&str]) -> Output {
 
 /// The suite's deadline: a tick starting more than this after its deadline is a miss, ms.
 /// The daemon's default (5 ms) is for the board; under TCG emulation the guest's timers and
-/// both virtual CPUs share this machine's two cores with the emulated world, and a sleeping
-/// SCHED_FIFO loop wakes 5-10 ms late now and then with nothing on the bus at all. 20 ms still
-/// puts every tick's setpoints out well inside its 50 ms period and the controllers' 150 ms
-/// brake timeout; `handctl status` shows the measured lateness.
-pub const DEADLINE_SLACK_MS: u32 = 20;
+/// both virtual CPUs share this machine's two cores with the emulated world, and the sleeping
+/// SCHED_FIFO loop wakes about 2 ms late typically and up to 15 ms late now and then (measured
+/// in the closed loop) with nothing else on the bus. Half a tick (the most the config allows)
+/// still puts every tick's setpoints out inside its 50 ms period and far inside the
+/// controllers' 150 ms brake timeout; `handctl status` shows the measured lateness.
+pub const DEADLINE_SLACK_MS: u32 = 25;
 
 /// A handd config file for one test.
 #[derive(Debug, Clone)]
