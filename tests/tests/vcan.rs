@@ -445,8 +445,9 @@ const ARM_US: u64 = 3_600_000;
 /// ACTIVE setpoints come back no sooner than this after `handctl arm`...
 const ARM_MIN_US: u64 = 500_000;
 /// ... and no later than this: the recovery time, plus the tick that applies the command and
-/// the tick that sees the period complete, plus handctl's way to the daemon under emulation.
-const ARM_BAR_US: u64 = 750_000;
+/// the tick that sees the period complete, plus starting handctl and its way to the daemon
+/// under emulation (measured 565-686 ms in all).
+const ARM_BAR_US: u64 = 900_000;
 
 /// Runs one handsim-injected fault and checks time to safe stop and the recovery rule.
 fn drill(d: &Drill<'_>) {
