@@ -460,16 +460,9 @@ fn drill(d: &Drill<'_>) {
     );
     let mut sim = rig.sim("sine", RUN_S, &["--fault", &fault]);
     // A latched fault stays until a technician arms the daemon again.
-    let armed = d.latched.then(|| {
-        let start = wait_scenario_start(&rig.monitor);
-        while now_us() < start + ARM_US {
-            std::thread::sleep(Duration::from_millis(2));
-        }
-        let at = now_us();
-        let sock = rig.cfg.socket.display().to_string();
-        handctl(&rig.env, &["arm", "--socket", &sock]);
-        at
-    });
+    let armed = d
+        .latched
+        .then(|| arm_at(&rig, wait_scenario_start(&rig.monitor) + ARM_US));
     sim.wait_success(Duration::from_secs(60));
     let seen = rig.monitor.finish();
     let start = scenario_start_us(&seen);
@@ -629,21 +622,7 @@ fn d6_bus_off_error_frame() {
     let mut sim = rig.sim("sine", RUN_S, &[]);
     let w = writer(&rig.env.iface);
     // Wait for the scenario's onset on the bus, then inject CAN_ERR_BUSOFF.
-    let begun = Instant::now();
-    let start = loop {
-        let seen = rig.monitor.snapshot();
-        if seen
-            .iter()
-            .any(|s| s.frame.as_ref().is_some_and(|f| f.raw_id() == 0x100))
-        {
-            break scenario_start_us(&seen);
-        }
-        assert!(
-            begun.elapsed() < Duration::from_secs(10),
-            "handsim never started"
-        );
-        std::thread::sleep(Duration::from_millis(10));
-    };
+    let start = wait_scenario_start(&rig.monitor);
     while now_us() < start + ONSET_US {
         std::thread::sleep(Duration::from_millis(1));
     }
@@ -651,12 +630,7 @@ fn d6_bus_off_error_frame() {
     w.write_frame(&busoff)
         .expect("vcan accepts an injected error frame");
     // Bus-off latches: the hand stays stopped until a technician arms the daemon again.
-    while now_us() < start + ARM_US {
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    let armed = now_us();
-    let sock = rig.cfg.socket.display().to_string();
-    handctl(&rig.env, &["arm", "--socket", &sock]);
+    let armed = arm_at(&rig, start + ARM_US);
     sim.wait_success(Duration::from_secs(60));
     let seen = rig.monitor.finish();
     let onset = seen
@@ -883,6 +857,17 @@ fn f_bad_input_flood_keeps_the_deadline() {
     );
     assert_eq!(misses, 0, "handd missed deadlines during the flood");
     drop(rig.monitor);
+}
+
+/// Runs `handctl arm` against the rig's daemon at bus time `at_us`; returns when it was sent.
+fn arm_at(rig: &Rig, at_us: u64) -> u64 {
+    while now_us() < at_us {
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    let sent = now_us();
+    let sock = rig.cfg.socket.display().to_string();
+    handctl(&rig.env, &["arm", "--socket", &sock]);
+    sent
 }
 
 /// Waits until handsim's first EMG sample is on the bus; its receive time (the scenario's 0).
