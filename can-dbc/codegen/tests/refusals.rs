@@ -1,0 +1,155 @@
+//! The generator refuses inconsistent DBCs with an error naming the message and signal, and
+//! accepts hand.dbc (moved from hand-dbc's tests/generator.rs).
+
+use hand_dbc_codegen::{generate, Bus, DbcError};
+
+const HEADER: &str = "VERSION \"\"\n\nNS_ :\n\nBS_:\n\nBU_: A B\n\n";
+const ATTRS: &str = "BA_DEF_ BO_ \"GenMsgCycleTime\" INT 0 65535;\n\
+BA_DEF_ BO_ \"HandE2EDataId\" INT 0 65535;\n\
+BA_DEF_DEF_ \"GenMsgCycleTime\" 10;\n\
+BA_DEF_DEF_ \"HandE2EDataId\" 0;\n";
+
+fn dbc(body: &str, extra: &str) -> String {
+    format!("{HEADER}{body}\n\n{ATTRS}{extra}\n")
+}
+
+fn refused(body: &str, extra: &str) -> DbcError {
+    match Bus::from_dbc(&dbc(body, extra)) {
+        Ok(_) => panic!("generator accepted:\n{body}\n{extra}"),
+        Err(e) => e,
+    }
+}
+
+fn names(message: &str, signal: &str) -> (String, String) {
+    (message.to_string(), signal.to_string())
+}
+
+#[test]
+fn hand_dbc_generates() {
+    let code = generate(include_str!("../../hand.dbc")).expect("hand.dbc is valid");
+    assert!(code.starts_with("// @generated from can-dbc/hand.dbc"));
+    assert!(code.contains("pub struct FingerSetpoint"));
+    assert!(code.contains("pub enum FingerMode"));
+    assert!(code.contains("pub const EMG0_RAW_MIN: i16 = -2048;"));
+}
+
+#[test]
+fn a_minimal_valid_dbc_generates() {
+    let body = "BO_ 16 M: 2 A\n SG_ X : 0|12@1- (0.5,1) [-100|100] \"V\" B\n";
+    let code = generate(&dbc(body, "")).expect("valid");
+    assert!(code.contains("pub struct M"));
+    assert!(code.contains("pub const X_FACTOR: f64 = 0.5;"));
+    assert!(code.contains("pub const X_RAW_MIN: i16 = -202;"));
+}
+
+#[test]
+fn families_become_one_type_with_an_instance() {
+    let body = "BO_ 16 F_0: 1 A\n SG_ X : 0|8@1+ (1,0) [0|255] \"u\" B\n\n\
+                BO_ 17 F_1: 1 A\n SG_ X : 0|8@1+ (1,0) [0|255] \"u\" B\n";
+    let bus = Bus::from_dbc(&dbc(body, "")).expect("valid");
+    assert_eq!(bus.groups.len(), 1);
+    assert!(bus.groups[0].is_family());
+    assert_eq!(bus.groups[0].ty, "F");
+}
+
+#[test]
+fn signal_refusals_name_message_and_signal() {
+    let m_x = names("M", "X");
+    let range = refused("BO_ 16 M: 1 A\n SG_ X : 0|8@1+ (1,0) [0|300] \"u\" B\n", "");
+    assert!(
+        matches!(&range, DbcError::RangeTooWide { message, signal, raw_max, .. }
+        if (message.clone(), signal.clone()) == m_x && *raw_max == 300.0)
+    );
+    assert!(range
+        .to_string()
+        .starts_with("M.X: range [0|300] needs raw"));
+    let beyond = refused("BO_ 16 M: 1 A\n SG_ X : 4|8@1+ (1,0) [0|255] \"u\" B\n", "");
+    assert!(matches!(
+        beyond,
+        DbcError::Bits {
+            start: 4,
+            size: 8,
+            dlc: 1,
+            ..
+        }
+    ));
+    assert!(beyond.to_string().starts_with("M.X: bits 4..12"));
+    let overlap = refused(
+        "BO_ 16 M: 2 A\n SG_ X : 0|8@1+ (1,0) [0|255] \"u\" B\n SG_ Y : 4|8@1+ (1,0) [0|255] \"u\" B\n",
+        "",
+    );
+    assert_eq!(
+        overlap,
+        DbcError::Overlap {
+            message: "M".into(),
+            signal: "Y".into()
+        }
+    );
+    assert_eq!(overlap.to_string(), "M.Y: overlaps another signal");
+    let motorola = refused("BO_ 16 M: 1 A\n SG_ X : 7|8@0+ (1,0) [0|255] \"u\" B\n", "");
+    assert_eq!(
+        motorola,
+        DbcError::ByteOrder {
+            message: "M".into(),
+            signal: "X".into()
+        }
+    );
+    let no_range = refused("BO_ 16 M: 1 A\n SG_ X : 0|8@1+ (1,0) [0|0] \"u\" B\n", "");
+    assert!(matches!(no_range, DbcError::NoRange { .. }));
+    assert!(no_range.to_string().starts_with("M.X: give a range"));
+}
+
+#[test]
+fn value_table_refusals_name_message_and_signal() {
+    let outside = refused(
+        "BO_ 16 M: 1 A\n SG_ X : 0|4@1+ (1,0) [0|2] \"u\" B\n",
+        "VAL_ 16 X 3 \"C\" 0 \"A\" ;",
+    );
+    assert!(matches!(&outside, DbcError::ValueOutOfRange { value: 3, name, .. } if name == "C"));
+    assert!(outside.to_string().starts_with("M.X: value 3"));
+    let scaled = refused(
+        "BO_ 16 M: 1 A\n SG_ X : 0|4@1+ (2,0) [0|30] \"u\" B\n",
+        "VAL_ 16 X 1 \"A\" ;",
+    );
+    assert_eq!(
+        scaled,
+        DbcError::ScaledEnum {
+            message: "M".into(),
+            signal: "X".into()
+        }
+    );
+}
+
+#[test]
+fn message_refusals_name_the_message() {
+    let e2e = refused(
+        "BO_ 16 M: 2 A\n SG_ Crc : 0|8@1+ (1,0) [0|255] \"u\" B\n SG_ Counter : 8|3@1+ (1,0) [0|7] \"u\" B\n",
+        "BA_ \"HandE2EDataId\" BO_ 16 4112;",
+    );
+    assert_eq!(
+        e2e,
+        DbcError::E2eLayout {
+            message: "M".into()
+        }
+    );
+    assert!(e2e.to_string().starts_with("M: E2E messages need"));
+    let dlc = refused("BO_ 16 M: 9 A\n SG_ X : 0|8@1+ (1,0) [0|255] \"u\" B\n", "");
+    assert_eq!(
+        dlc,
+        DbcError::Dlc {
+            message: "M".into(),
+            dlc: 9
+        }
+    );
+    assert!(dlc.to_string().starts_with("M: DLC 9"));
+    let shared = refused(
+        "BO_ 16 M: 1 A\n SG_ X : 0|8@1+ (1,0) [0|255] \"u\" B\n\nBO_ 16 N: 1 A\n SG_ X : 0|8@1+ (1,0) [0|255] \"u\" B\n",
+        "",
+    );
+    assert!(matches!(shared, DbcError::SharedId { id: 16, .. }));
+    let wide = refused(
+        "BO_ 2048 M: 1 A\n SG_ X : 0|8@1+ (1,0) [0|255] \"u\" B\n",
+        "",
+    );
+    assert!(matches!(wide, DbcError::IdTooWide { id: 2048, .. }));
+}
