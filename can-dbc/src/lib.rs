@@ -1,8 +1,10 @@
 //! The handstack CAN bus: `hand.dbc` is the single source of truth for every frame on the
 //! prosthesis's bus, and this crate owns it.
 //!
-//! - [`messages`]: message types generated from hand.dbc at build time, with the
-//!   [`messages::decode`] dispatcher and [`messages::Message`].
+//! - [`messages`]: message types generated from hand.dbc by `hand-dbc-codegen`
+//!   (`cargo run -p hand-dbc-codegen --bin hand-dbc-gen`) into the checked-in module
+//!   `src/messages/generated.rs`, with the [`messages::decode`] dispatcher and
+//!   [`messages::Message`].
 //! - [`CanFrame`]: the concrete classic-CAN frame (implements [`embedded_can::Frame`]).
 //! - [`e2e`]: alive counter + CRC-8 SAE J1850 protection and the receiver-side checker.
 //! - [`emg`]: reassembly of 12-channel sEMG samples from the three EMG frame groups.

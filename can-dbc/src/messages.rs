@@ -1,25 +1,28 @@
-//! The message types of hand.dbc, generated at build time by `build.rs` (edit hand.dbc and
-//! rebuild; never edit the generated code).
+//! The message types of hand.dbc. The code is generated from hand.dbc by the
+//! `hand-dbc-codegen` crate (`can-dbc/codegen`) into the checked-in, reviewed module
+//! `src/messages/generated.rs`: edit hand.dbc, run
+//! `cargo run -p hand-dbc-codegen --bin hand-dbc-gen`, and commit both; never edit the
+//! generated file. `cargo test -p hand-dbc-codegen` fails while it is out of date.
 //!
 //! One type per message, or one type with an instance index for a family of identical
 //! per-finger messages (`FINGER_SETPOINT_0..4` -> [`FingerSetpoint`], instance = finger).
-//! Every type has `NAME`, `ID` (or `IDS`), `DLC`, `CYCLE_TIME_MS`, per-signal `_MIN`/`_MAX`
-//! (and `_FACTOR`/`_OFFSET` for scaled signals) consts, `E2E` for protected messages, a
-//! checked `new`, getters returning physical values (`_raw` for the bus integer), checked
-//! setters, `decode`/`encode`, `to_frame`/`to_can_frame`/`try_from_frame`. Value tables become
-//! enums. [`decode`] dispatches a payload by id into [`Message`].
+//! Every type has `NAME`, `ID` (or `IDS` and `INSTANCES`), `DLC`, `CYCLE_TIME_MS`, per-signal
+//! `_MIN`/`_MAX` (and `_FACTOR`/`_OFFSET`/`_RAW_MIN`/`_RAW_MAX` for scaled signals) consts,
+//! `E2E` for protected messages, a checked `new`, getters returning physical values (`_raw`
+//! for the bus integer), checked setters, `decode`/`encode`,
+//! `to_frame`/`to_can_frame`/`try_from_frame`. Value tables become enums. [`decode`]
+//! dispatches a payload by id into [`Message`]; [`MESSAGES`] is the DBC as data.
 //!
 //! Values outside the DBC's `[min, max]` are refused with [`CodecError`] when set and when
 //! decoded: the codec never wraps and never saturates.
 
 use embedded_can::{Frame, Id};
 
-use crate::e2e::E2eProfile;
 pub use crate::error::CodecError;
-use crate::frame::CanFrame;
 pub use crate::info::{MessageInfo, SignalInfo};
 
-include!(concat!(env!("OUT_DIR"), "/messages.rs"));
+mod generated;
+pub use generated::*;
 
 /// The 11-bit id of a data frame, or why the frame cannot be one of hand.dbc's.
 fn standard_data_frame<F: Frame>(frame: &F) -> Result<u32, CodecError> {
