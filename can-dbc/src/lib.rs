@@ -5,6 +5,9 @@
 //!   (`cargo run -p hand-dbc-codegen --bin hand-dbc-gen`) into the checked-in module
 //!   `src/messages/generated.rs`, with the [`messages::decode`] dispatcher and
 //!   [`messages::Message`].
+//! - [`hand`]: the hand's constants from the DBC: [`hand::N_FINGERS`], [`hand::FINGER_NAMES`]
+//!   (0 thumb .. 4 pinky), [`hand::finger_index`], the EMG ADC rails [`hand::ADC_MIN`] and
+//!   [`hand::ADC_MAX`].
 //! - [`CanFrame`]: the concrete classic-CAN frame (implements [`embedded_can::Frame`]).
 //! - [`e2e`]: alive counter + CRC-8 SAE J1850 protection and the receiver-side checker.
 //! - [`emg`]: reassembly of 12-channel sEMG samples from the three EMG frame groups.
@@ -43,6 +46,7 @@ pub mod e2e;
 pub mod emg;
 mod error;
 mod frame;
+pub mod hand;
 mod info;
 pub mod messages;
 
