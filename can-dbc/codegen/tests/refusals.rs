@@ -153,3 +153,73 @@ fn message_refusals_name_the_message() {
     );
     assert!(matches!(wide, DbcError::IdTooWide { id: 2048, .. }));
 }
+
+#[test]
+fn layout_and_scaling_refusals() {
+    let mux = refused(
+        "BO_ 16 M: 2 A\n SG_ Mux M : 0|8@1+ (1,0) [0|255] \"u\" B\n SG_ X m0 : 8|8@1+ (1,0) [0|255] \"u\" B\n",
+        "",
+    );
+    assert_eq!(
+        mux,
+        DbcError::Multiplexed {
+            message: "M".into(),
+            signal: "Mux".into()
+        }
+    );
+    let factor = refused("BO_ 16 M: 1 A\n SG_ X : 0|8@1+ (0,0) [0|255] \"u\" B\n", "");
+    assert_eq!(
+        factor,
+        DbcError::Factor {
+            message: "M".into(),
+            signal: "X".into()
+        }
+    );
+    let extended = refused(
+        "BO_ 2147483664 M: 1 A\n SG_ X : 0|8@1+ (1,0) [0|255] \"u\" B\n",
+        "",
+    );
+    assert_eq!(
+        extended,
+        DbcError::ExtendedId {
+            message: "M".into()
+        }
+    );
+    assert!(matches!(
+        Bus::from_dbc("not a dbc"),
+        Err(DbcError::Parse(_))
+    ));
+}
+
+#[test]
+fn two_value_tables_for_one_enum_name_are_refused() {
+    // M.X_Y and M_X.Y both become enum `MXY`, with different values.
+    let conflict = refused(
+        "BO_ 16 M: 1 A\n SG_ X_Y : 0|2@1+ (1,0) [0|1] \"\" B\n\n\
+         BO_ 17 M_X: 1 A\n SG_ Y : 0|2@1+ (1,0) [0|2] \"\" B\n",
+        "VAL_ 16 X_Y 0 \"A\" 1 \"B\" ;\nVAL_ 17 Y 0 \"A\" 2 \"C\" ;",
+    );
+    assert_eq!(
+        conflict,
+        DbcError::EnumConflict {
+            message: "M_X".into(),
+            signal: "Y".into(),
+            name: "MXY".into()
+        }
+    );
+}
+
+#[test]
+fn a_message_without_a_cycle_time_is_refused() {
+    let text = format!(
+        "{HEADER}BO_ 16 M: 1 A\n SG_ X : 0|8@1+ (1,0) [0|255] \"u\" B\n\n\
+         BA_DEF_ BO_ \"GenMsgCycleTime\" INT 0 65535;\n"
+    );
+    let err = Bus::from_dbc(&text).expect_err("no GenMsgCycleTime");
+    assert_eq!(
+        err,
+        DbcError::NoCycleTime {
+            message: "M".into()
+        }
+    );
+}
