@@ -33,7 +33,7 @@ use super::error::FileError;
 use super::kind::ModelKind;
 use super::normalizer::Normalizer;
 use super::spec::ModelSpec;
-use super::train::TrainingSummary;
+use super::summary::TrainingSummary;
 use super::trained::TrainedModel;
 use super::traits::{Model, Trainable};
 

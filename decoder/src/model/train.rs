@@ -6,8 +6,6 @@
 
 use std::time::Instant;
 
-use serde::{Deserialize, Serialize};
-
 use super::any::AnyModel;
 use super::config::TrainConfig;
 use super::dataset::{Dataset, N_FINGERS};
@@ -18,6 +16,7 @@ use super::normalizer::Normalizer;
 use super::optim::OptimState;
 use super::spec::ModelSpec;
 use super::split::make_split;
+use super::summary::TrainingSummary;
 use super::trained::TrainedModel;
 use super::traits::{Model, Scratch, Trainable};
 
@@ -35,56 +34,6 @@ pub struct EpochReport {
     pub val_loss: Option<f64>,
     /// Epoch with the best validation loss so far (the current one without a split).
     pub best_epoch: usize,
-}
-
-/// What training did; stored in the model file.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TrainingSummary {
-    /// Architecture trained.
-    pub kind: ModelKind,
-    /// Settings used.
-    pub config: TrainConfig,
-    /// Epochs run.
-    pub epochs_run: usize,
-    /// Epoch whose weights were kept.
-    pub best_epoch: usize,
-    /// Whether early stopping ended training before `max_epochs`.
-    pub stopped_early: bool,
-    /// Training loss of the last epoch run.
-    pub final_train_loss: f64,
-    /// Validation loss of the kept weights (None without a split).
-    pub best_val_loss: Option<f64>,
-    /// Training windows.
-    pub n_train_windows: usize,
-    /// Held-out windows.
-    pub n_val_windows: usize,
-    /// Distinct trials in the training part.
-    pub n_train_trials: usize,
-    /// Distinct trials in the held-out part.
-    pub n_val_trials: usize,
-    /// Wall-clock training time in milliseconds (informative only; never affects results).
-    pub duration_ms: u64,
-}
-
-impl TrainingSummary {
-    /// The summary of a model that was never trained (random weights, for tests, benchmarks
-    /// and tools that build a [`TrainedModel`] by hand).
-    pub fn untrained(kind: ModelKind) -> Self {
-        TrainingSummary {
-            kind,
-            config: TrainConfig::default(),
-            epochs_run: 0,
-            best_epoch: 0,
-            stopped_early: false,
-            final_train_loss: 0.0,
-            best_val_loss: None,
-            n_train_windows: 0,
-            n_val_windows: 0,
-            n_train_trials: 0,
-            n_val_trials: 0,
-            duration_ms: 0,
-        }
-    }
 }
 
 /// Masked MSE of `model` over windows `idx` (normalized features in `xn`).

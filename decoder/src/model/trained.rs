@@ -8,7 +8,7 @@ use super::dataset::N_FINGERS;
 use super::error::ModelError;
 use super::normalizer::Normalizer;
 use super::spec::ModelSpec;
-use super::train::TrainingSummary;
+use super::summary::TrainingSummary;
 use super::traits::{Model, Scratch, Trainable};
 
 /// Model + normalizer + chain configuration + training summary (what a model file holds).
