@@ -227,7 +227,8 @@ fn the_last_repetition_of_each_kind_is_held_out() {
 #[test]
 fn interpolation_scales_the_chain_s_var_column_by_k_squared() {
     // The interpolation analysis assumes the chain's feature order; keep the two in step.
-    use decoder::eval::{FEATURES_PER_CHANNEL, VAR_INDEX};
+    use decoder::dsp::FEATURES_PER_CHANNEL;
+    use decoder::eval::VAR_INDEX;
     assert_eq!(FEATURES_PER_CHANNEL, decoder::dsp::FEATURE_NAMES.len());
     assert_eq!(decoder::dsp::FEATURE_NAMES[VAR_INDEX], "VAR");
 }

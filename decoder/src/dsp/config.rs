@@ -192,6 +192,28 @@ impl ChainConfig {
         if !fs.is_finite() || fs <= 0.0 {
             return Err(ConfigError::SampleRate(fs));
         }
+        self.check_bandpass(fs)?;
+        let notch_freqs = self.notch_freqs(fs)?;
+        let (dc, low) = (self.dc_cutoff_hz, self.band_low_hz);
+        if !(dc.is_finite() && dc > 0.0 && dc < low) {
+            return Err(ConfigError::DcCutoff { cutoff: dc, low });
+        }
+        let (window_len, step_len) = self.window_and_step(fs)?;
+        let (cascade, n_bandpass) = self.design(&notch_freqs);
+        Ok(ChainSettings {
+            inner: Arc::new(Inner {
+                config: self.clone(),
+                cascade,
+                n_bandpass,
+                notch_freqs,
+                window_len,
+                step_len,
+            }),
+        })
+    }
+
+    /// The band edges (positive, ordered, below Nyquist) and the Butterworth order.
+    fn check_bandpass(&self, fs: f64) -> Result<(), ConfigError> {
         let nyquist = fs / 2.0;
         let (low, high) = (self.band_low_hz, self.band_high_hz);
         if !low.is_finite() || !high.is_finite() || low <= 0.0 || high <= low {
@@ -203,6 +225,12 @@ impl ChainConfig {
         if self.bandpass_order == 0 || self.bandpass_order > MAX_ORDER {
             return Err(ConfigError::Order(self.bandpass_order));
         }
+        Ok(())
+    }
+
+    /// The notch centre frequencies, fundamental first, after checking the mains frequency,
+    /// the quality factor and that every harmonic is below Nyquist.
+    fn notch_freqs(&self, fs: f64) -> Result<Vec<f64>, ConfigError> {
         if self.mains_hz != 50 && self.mains_hz != 60 {
             return Err(ConfigError::Mains(self.mains_hz));
         }
@@ -210,6 +238,7 @@ impl ChainConfig {
         if !(q.is_finite() && q >= Q_RANGE.0 && q <= Q_RANGE.1) {
             return Err(ConfigError::NotchQ(q));
         }
+        let nyquist = fs / 2.0;
         let n_notches = self.mains_harmonics as usize + 1;
         let mut notch_freqs = Vec::with_capacity(n_notches);
         for h in 1..=n_notches {
@@ -224,10 +253,11 @@ impl ChainConfig {
             }
             notch_freqs.push(freq);
         }
-        let dc = self.dc_cutoff_hz;
-        if !(dc.is_finite() && dc > 0.0 && dc < low) {
-            return Err(ConfigError::DcCutoff { cutoff: dc, low });
-        }
+        Ok(notch_freqs)
+    }
+
+    /// Window and step lengths in samples (whole numbers, the step no longer than the window).
+    fn window_and_step(&self, fs: f64) -> Result<(usize, usize), ConfigError> {
         let window_len = whole_samples("window_ms", self.window_ms, fs, 2)?;
         let step_len = whole_samples("step_ms", self.step_ms, fs, 1)?;
         if step_len > window_len {
@@ -239,24 +269,25 @@ impl ChainConfig {
                 why: "must not be longer than window_ms (samples would be skipped)",
             });
         }
+        Ok((window_len, step_len))
+    }
 
-        let dc_section = dc_highpass(dc, fs);
-        let bandpass = butter_bandpass(self.bandpass_order, low, high, fs);
-        let notches: Vec<Sos> = notch_freqs.iter().map(|&f| iirnotch(f, q, fs)).collect();
+    /// The filter cascade in running order (DC section, band-pass sections, notches) and the
+    /// number of band-pass sections in it. Only for a checked configuration.
+    fn design(&self, notch_freqs: &[f64]) -> (Vec<Sos>, usize) {
+        let fs = self.sample_rate_hz;
+        let dc_section = dc_highpass(self.dc_cutoff_hz, fs);
+        let bandpass =
+            butter_bandpass(self.bandpass_order, self.band_low_hz, self.band_high_hz, fs);
+        let notches: Vec<Sos> = notch_freqs
+            .iter()
+            .map(|&f| iirnotch(f, self.notch_q, fs))
+            .collect();
         let mut cascade = Vec::with_capacity(1 + bandpass.len() + notches.len());
         cascade.push(dc_section);
         cascade.extend_from_slice(&bandpass);
         cascade.extend_from_slice(&notches);
-        Ok(ChainSettings {
-            inner: Arc::new(Inner {
-                config: self.clone(),
-                cascade,
-                n_bandpass: bandpass.len(),
-                notch_freqs,
-                window_len,
-                step_len,
-            }),
-        })
+        (cascade, bandpass.len())
     }
 }
 

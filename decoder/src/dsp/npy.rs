@@ -48,6 +48,33 @@ pub fn read_npy(path: impl AsRef<Path>) -> Result<NpyArray, NpyError> {
 
 /// Parses the bytes of a `.npy` file.
 pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, NpyError> {
+    let (header, data_start) = header_text(bytes)?;
+    let descr = dict_value(header, "descr")?;
+    let descr = descr.trim().trim_matches(|c| c == '\'' || c == '"');
+    let fortran = dict_value(header, "fortran_order")?;
+    if fortran.trim() != "False" {
+        return Err(format_err("Fortran-order arrays are not supported"));
+    }
+    let shape = parse_shape(dict_value(header, "shape")?)?;
+    let count: usize = shape.iter().product();
+    let payload = &bytes[data_start..];
+    let (size, convert) = dtype(descr)?;
+    let needed = count
+        .checked_mul(size)
+        .ok_or_else(|| format_err("shape too large"))?;
+    if payload.len() < needed {
+        return Err(format_err(format!(
+            "data holds {} bytes, shape {shape:?} of {descr} needs {needed}",
+            payload.len()
+        )));
+    }
+    let data = payload[..needed].chunks_exact(size).map(convert).collect();
+    Ok(NpyArray { shape, data })
+}
+
+/// The header's text (a Python dict literal) and where the data starts, after checking the
+/// magic and the format version.
+fn header_text(bytes: &[u8]) -> Result<(&str, usize), NpyError> {
     if bytes.len() < 10 || &bytes[..6] != b"\x93NUMPY" {
         return Err(format_err("not an NPY file (bad magic)"));
     }
@@ -70,19 +97,14 @@ pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, NpyError> {
         .get(header_start..data_start)
         .ok_or_else(|| format_err("truncated NPY header"))?;
     let header = std::str::from_utf8(header).map_err(|_| format_err("NPY header is not text"))?;
+    Ok((header, data_start))
+}
 
-    let descr = dict_value(header, "descr")?;
-    let descr = descr.trim().trim_matches(|c| c == '\'' || c == '"');
-    let fortran = dict_value(header, "fortran_order")?;
-    if fortran.trim() != "False" {
-        return Err(format_err("Fortran-order arrays are not supported"));
-    }
-    let shape_text = dict_value(header, "shape")?;
-    let shape_text = shape_text
-        .trim()
+/// The shape tuple's text, e.g. `(3, 2)` or `(4,)`, as sizes.
+fn parse_shape(text: &str) -> Result<Vec<usize>, NpyError> {
+    text.trim()
         .trim_start_matches('(')
-        .trim_end_matches(')');
-    let shape: Vec<usize> = shape_text
+        .trim_end_matches(')')
         .split(',')
         .map(str::trim)
         .filter(|s| !s.is_empty())
@@ -90,11 +112,15 @@ pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, NpyError> {
             s.parse::<usize>()
                 .map_err(|_| format_err(format!("bad shape entry {s:?}")))
         })
-        .collect::<Result<_, _>>()?;
-    let count: usize = shape.iter().product();
-    let payload = &bytes[data_start..];
+        .collect()
+}
 
-    let (size, convert): (usize, fn(&[u8]) -> f64) = match descr {
+/// Converts one little-endian element to f64.
+type Convert = fn(&[u8]) -> f64;
+
+/// Bytes per element and the conversion to f64 of a supported dtype.
+fn dtype(descr: &str) -> Result<(usize, Convert), NpyError> {
+    let found: (usize, Convert) = match descr {
         "<i2" => (2, |b| i16::from_le_bytes([b[0], b[1]]) as f64),
         "<i4" => (4, |b| i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64),
         "<f4" => (4, |b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64),
@@ -107,17 +133,7 @@ pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, NpyError> {
             )))
         }
     };
-    let needed = count
-        .checked_mul(size)
-        .ok_or_else(|| format_err("shape too large"))?;
-    if payload.len() < needed {
-        return Err(format_err(format!(
-            "data holds {} bytes, shape {shape:?} of {descr} needs {needed}",
-            payload.len()
-        )));
-    }
-    let data = payload[..needed].chunks_exact(size).map(convert).collect();
-    Ok(NpyArray { shape, data })
+    Ok(found)
 }
 
 /// The raw text of `key`'s value in the header's Python dict literal.

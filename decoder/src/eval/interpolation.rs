@@ -13,10 +13,10 @@
 
 use super::error::EvalError;
 use super::stats::{linear_fit, spearman};
+use crate::dsp::FEATURES_PER_CHANNEL;
 
-/// Features per channel in the chain's order RMS, MAV, VAR, SD, INT, WL, DASDV, DAMV.
-pub const FEATURES_PER_CHANNEL: usize = 8;
-/// Position of VAR (the only power-like feature) within a channel's features.
+/// Position of VAR (the only power-like feature) within a channel's features, in the chain's
+/// order [`crate::dsp::FEATURE_NAMES`].
 pub const VAR_INDEX: usize = 2;
 
 /// How the curves are sampled and judged.

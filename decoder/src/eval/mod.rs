@@ -21,7 +21,7 @@ pub use error::EvalError;
 pub use evaluate::{evaluate_model, ModelEvaluation};
 pub use interpolation::{
     interpolation_curves, judge_curve, scale_features, InterpolationConfig, InterpolationCurve,
-    InterpolationInput, InterpolationSummary, FEATURES_PER_CHANNEL, VAR_INDEX,
+    InterpolationInput, InterpolationSummary, VAR_INDEX,
 };
 pub use plot::{interpolation_png, roc_png};
 pub use stats::{average_ranks, linear_fit, pearson, spearman, LinearFit};

@@ -33,9 +33,9 @@ use super::error::FileError;
 use super::kind::ModelKind;
 use super::normalizer::Normalizer;
 use super::spec::ModelSpec;
-use super::train::TrainingSummary;
+use super::summary::TrainingSummary;
 use super::trained::TrainedModel;
-use super::traits::{Model, Trainable};
+use super::traits::{Model, TensorInfo, Trainable};
 
 /// Magic bytes at the start of every model file.
 pub const MAGIC: [u8; 8] = *b"HSMODEL\n";
@@ -95,23 +95,203 @@ fn differing_fields(a: &serde_json::Value, b: &serde_json::Value) -> Vec<String>
     }
 }
 
+/// The first non-finite value of `params`, as an error naming its tensor.
+fn check_finite(params: &[f64], tensors: &[TensorInfo]) -> Result<(), FileError> {
+    for t in tensors {
+        if let Some(index) = params[t.offset..t.offset + t.len()]
+            .iter()
+            .position(|p| !p.is_finite())
+        {
+            return Err(FileError::NonFiniteWeight {
+                tensor: t.name.clone(),
+                index,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The body of a file, after checking the header: magic, version, length, checksum.
+fn checked_body(bytes: &[u8]) -> Result<&[u8], FileError> {
+    if bytes.len() < HEADER_LEN || bytes[..8] != MAGIC {
+        return Err(FileError::NotAModelFile);
+    }
+    let word = |r: std::ops::Range<usize>| -> [u8; 4] { bytes[r].try_into().expect("4 bytes") };
+    let version = u32::from_le_bytes(word(8..12));
+    if version != FORMAT_VERSION {
+        return Err(FileError::UnknownVersion {
+            found: version,
+            supported: FORMAT_VERSION,
+        });
+    }
+    let stored_crc = u32::from_le_bytes(word(12..16));
+    let body_len = u64::from_le_bytes(bytes[16..24].try_into().expect("8 bytes"));
+    let body = &bytes[HEADER_LEN..];
+    if body.len() as u64 != body_len {
+        return Err(FileError::Length {
+            expected: body_len,
+            found: body.len() as u64,
+        });
+    }
+    let computed = crc32fast::hash(body);
+    if computed != stored_crc {
+        return Err(FileError::BadChecksum {
+            stored: stored_crc,
+            computed,
+        });
+    }
+    Ok(body)
+}
+
+/// The body's JSON metadata, and the weight data that follows it.
+fn read_meta(body: &[u8]) -> Result<(Meta, &[u8]), FileError> {
+    let malformed = |m: String| FileError::Malformed(m);
+    if body.len() < 8 {
+        return Err(malformed("body too short for the metadata length".into()));
+    }
+    let meta_len = u64::from_le_bytes(body[..8].try_into().expect("8 bytes"));
+    let rest = &body[8..];
+    if meta_len > rest.len() as u64 {
+        return Err(malformed(format!(
+            "metadata length {meta_len} exceeds the {} bytes present",
+            rest.len()
+        )));
+    }
+    let (meta_bytes, data) = rest.split_at(meta_len as usize);
+    let meta: Meta =
+        serde_json::from_slice(meta_bytes).map_err(|e| malformed(format!("metadata: {e}")))?;
+    if meta.format != FORMAT_NAME {
+        return Err(malformed(format!(
+            "format name {:?}, expected {FORMAT_NAME:?}",
+            meta.format
+        )));
+    }
+    Ok((meta, data))
+}
+
+/// The metadata's signal chain configuration: valid, and agreeing with the header fields.
+fn meta_chain(meta: &Meta) -> Result<ChainConfig, FileError> {
+    let malformed = |m: String| FileError::Malformed(m);
+    let chain: ChainConfig = serde_json::from_value(meta.chain.clone())
+        .map_err(|e| malformed(format!("signal chain configuration: {e}")))?;
+    chain
+        .validate()
+        .map_err(|e| malformed(format!("signal chain configuration: {e}")))?;
+    if meta.n_channels != chain.channels || meta.sample_rate_hz != chain.sample_rate_hz {
+        return Err(malformed(format!(
+            "header says {} channels at {} Hz, the chain configuration {} at {} Hz",
+            meta.n_channels, meta.sample_rate_hz, chain.channels, chain.sample_rate_hz
+        )));
+    }
+    Ok(chain)
+}
+
+/// Checks the stored sizes and tensor list against those of the kind and spec for `n_in`
+/// inputs; returns the model's tensors.
+fn check_shapes(meta: &Meta, n_in: usize) -> Result<Vec<TensorInfo>, FileError> {
+    if meta.n_inputs != n_in {
+        return Err(FileError::WrongShape {
+            tensor: "input".into(),
+            expected: vec![n_in],
+            found: vec![meta.n_inputs],
+        });
+    }
+    if meta.n_outputs != N_FINGERS {
+        return Err(FileError::WrongShape {
+            tensor: "output".into(),
+            expected: vec![N_FINGERS],
+            found: vec![meta.n_outputs],
+        });
+    }
+    let expected = AnyModel::expected_tensors(meta.kind, &meta.spec, n_in, N_FINGERS)?;
+    check_tensor_list(&expected, &meta.tensors)?;
+    if meta.normalizer.name != NORMALIZER_TENSOR || meta.normalizer.shape != [n_in] {
+        return Err(FileError::WrongShape {
+            tensor: NORMALIZER_TENSOR.into(),
+            expected: vec![n_in],
+            found: meta.normalizer.shape.clone(),
+        });
+    }
+    Ok(expected)
+}
+
+/// The stored tensors must be the expected ones: same names and shapes, in the same order.
+fn check_tensor_list(expected: &[TensorInfo], found: &[TensorMeta]) -> Result<(), FileError> {
+    for i in 0..expected.len().max(found.len()) {
+        match (expected.get(i), found.get(i)) {
+            (Some(e), Some(f)) if e.name == f.name && e.shape == f.shape => {}
+            (Some(e), f) => {
+                return Err(FileError::WrongShape {
+                    tensor: e.name.clone(),
+                    expected: e.shape.clone(),
+                    found: f.map(|f| f.shape.clone()).unwrap_or_default(),
+                })
+            }
+            (None, Some(f)) => {
+                return Err(FileError::WrongShape {
+                    tensor: f.name.clone(),
+                    expected: Vec::new(),
+                    found: f.shape.clone(),
+                })
+            }
+            (None, None) => unreachable!("loop bound is the longer list"),
+        }
+    }
+    Ok(())
+}
+
+/// The doubles after the metadata: the `expected` tensors' parameters, then `n_in` normalizer
+/// scales; all finite, the scales not negative.
+fn read_weights(data: &[u8], expected: &[TensorInfo], n_in: usize) -> Result<Vec<f64>, FileError> {
+    let n_params: usize = expected.iter().map(|t| t.len()).sum();
+    let want_bytes = 8 * (n_params as u64 + n_in as u64);
+    if data.len() as u64 != want_bytes {
+        return Err(FileError::Malformed(format!(
+            "weight data is {} bytes, the tensors need {want_bytes}",
+            data.len()
+        )));
+    }
+    let values: Vec<f64> = data
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
+        .collect();
+    let (params, scales) = values.split_at(n_params);
+    check_finite(params, expected)?;
+    if let Some(index) = scales.iter().position(|s| !s.is_finite() || *s < 0.0) {
+        return Err(FileError::NonFiniteWeight {
+            tensor: NORMALIZER_TENSOR.into(),
+            index,
+        });
+    }
+    Ok(values)
+}
+
+/// With an `expected` configuration, refuses a model whose chain differs from it, naming the
+/// fields that differ (`stored` is the configuration as the file wrote it).
+fn check_chain(
+    stored: &serde_json::Value,
+    chain: &ChainConfig,
+    expected: Option<&ChainConfig>,
+) -> Result<(), FileError> {
+    if let Some(exp) = expected {
+        if exp != chain {
+            let want =
+                serde_json::to_value(exp).map_err(|e| FileError::Malformed(e.to_string()))?;
+            return Err(FileError::ChainMismatch {
+                fields: differing_fields(stored, &want),
+            });
+        }
+    }
+    Ok(())
+}
+
 impl TrainedModel {
     /// The file contents (see the module docs). Errors only if the model holds a non-finite
     /// value (which its constructors prevent) or the metadata cannot be serialised.
     pub fn to_bytes(&self) -> Result<Vec<u8>, FileError> {
         let params = self.model.params();
         let tensors = self.model.tensors();
-        for t in &tensors {
-            if let Some(index) = params[t.offset..t.offset + t.len()]
-                .iter()
-                .position(|p| !p.is_finite())
-            {
-                return Err(FileError::NonFiniteWeight {
-                    tensor: t.name.clone(),
-                    index,
-                });
-            }
-        }
+        check_finite(params, &tensors)?;
         let chain =
             serde_json::to_value(&self.chain).map_err(|e| FileError::Malformed(e.to_string()))?;
         let meta = Meta {
@@ -163,148 +343,16 @@ impl TrainedModel {
         bytes: &[u8],
         expected_chain: Option<&ChainConfig>,
     ) -> Result<Self, FileError> {
-        if bytes.len() < HEADER_LEN || bytes[..8] != MAGIC {
-            return Err(FileError::NotAModelFile);
-        }
-        let word = |r: std::ops::Range<usize>| -> [u8; 4] { bytes[r].try_into().expect("4 bytes") };
-        let version = u32::from_le_bytes(word(8..12));
-        if version != FORMAT_VERSION {
-            return Err(FileError::UnknownVersion {
-                found: version,
-                supported: FORMAT_VERSION,
-            });
-        }
-        let stored_crc = u32::from_le_bytes(word(12..16));
-        let body_len = u64::from_le_bytes(bytes[16..24].try_into().expect("8 bytes"));
-        let body = &bytes[HEADER_LEN..];
-        if body.len() as u64 != body_len {
-            return Err(FileError::Length {
-                expected: body_len,
-                found: body.len() as u64,
-            });
-        }
-        let computed = crc32fast::hash(body);
-        if computed != stored_crc {
-            return Err(FileError::BadChecksum {
-                stored: stored_crc,
-                computed,
-            });
-        }
-        let malformed = |m: String| FileError::Malformed(m);
-        if body.len() < 8 {
-            return Err(malformed("body too short for the metadata length".into()));
-        }
-        let meta_len = u64::from_le_bytes(body[..8].try_into().expect("8 bytes"));
-        let rest = &body[8..];
-        if meta_len > rest.len() as u64 {
-            return Err(malformed(format!(
-                "metadata length {meta_len} exceeds the {} bytes present",
-                rest.len()
-            )));
-        }
-        let (meta_bytes, data) = rest.split_at(meta_len as usize);
-        let meta: Meta =
-            serde_json::from_slice(meta_bytes).map_err(|e| malformed(format!("metadata: {e}")))?;
-        if meta.format != FORMAT_NAME {
-            return Err(malformed(format!(
-                "format name {:?}, expected {FORMAT_NAME:?}",
-                meta.format
-            )));
-        }
-        let chain: ChainConfig = serde_json::from_value(meta.chain.clone())
-            .map_err(|e| malformed(format!("signal chain configuration: {e}")))?;
-        chain
-            .validate()
-            .map_err(|e| malformed(format!("signal chain configuration: {e}")))?;
-        if meta.n_channels != chain.channels || meta.sample_rate_hz != chain.sample_rate_hz {
-            return Err(malformed(format!(
-                "header says {} channels at {} Hz, the chain configuration {} at {} Hz",
-                meta.n_channels, meta.sample_rate_hz, chain.channels, chain.sample_rate_hz
-            )));
-        }
+        let body = checked_body(bytes)?;
+        let (meta, data) = read_meta(body)?;
+        let chain = meta_chain(&meta)?;
         let n_in = FEATURES_PER_CHANNEL * chain.channels;
-        if meta.n_inputs != n_in {
-            return Err(FileError::WrongShape {
-                tensor: "input".into(),
-                expected: vec![n_in],
-                found: vec![meta.n_inputs],
-            });
-        }
-        if meta.n_outputs != N_FINGERS {
-            return Err(FileError::WrongShape {
-                tensor: "output".into(),
-                expected: vec![N_FINGERS],
-                found: vec![meta.n_outputs],
-            });
-        }
-        let expected = AnyModel::expected_tensors(meta.kind, &meta.spec, n_in, N_FINGERS)?;
-        for i in 0..expected.len().max(meta.tensors.len()) {
-            match (expected.get(i), meta.tensors.get(i)) {
-                (Some(e), Some(f)) if e.name == f.name && e.shape == f.shape => {}
-                (Some(e), f) => {
-                    return Err(FileError::WrongShape {
-                        tensor: e.name.clone(),
-                        expected: e.shape.clone(),
-                        found: f.map(|f| f.shape.clone()).unwrap_or_default(),
-                    })
-                }
-                (None, Some(f)) => {
-                    return Err(FileError::WrongShape {
-                        tensor: f.name.clone(),
-                        expected: Vec::new(),
-                        found: f.shape.clone(),
-                    })
-                }
-                (None, None) => unreachable!("loop bound is the longer list"),
-            }
-        }
-        if meta.normalizer.name != NORMALIZER_TENSOR || meta.normalizer.shape != [n_in] {
-            return Err(FileError::WrongShape {
-                tensor: NORMALIZER_TENSOR.into(),
-                expected: vec![n_in],
-                found: meta.normalizer.shape.clone(),
-            });
-        }
-        let n_params: usize = expected.iter().map(|t| t.len()).sum();
-        let want_bytes = 8 * (n_params as u64 + n_in as u64);
-        if data.len() as u64 != want_bytes {
-            return Err(malformed(format!(
-                "weight data is {} bytes, the tensors need {want_bytes}",
-                data.len()
-            )));
-        }
-        let values: Vec<f64> = data
-            .chunks_exact(8)
-            .map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes")))
-            .collect();
-        let (params, scales) = values.split_at(n_params);
-        for t in &expected {
-            if let Some(index) = params[t.offset..t.offset + t.len()]
-                .iter()
-                .position(|p| !p.is_finite())
-            {
-                return Err(FileError::NonFiniteWeight {
-                    tensor: t.name.clone(),
-                    index,
-                });
-            }
-        }
-        if let Some(index) = scales.iter().position(|s| !s.is_finite() || *s < 0.0) {
-            return Err(FileError::NonFiniteWeight {
-                tensor: NORMALIZER_TENSOR.into(),
-                index,
-            });
-        }
-        if let Some(exp) = expected_chain {
-            if *exp != chain {
-                let want = serde_json::to_value(exp).map_err(|e| malformed(e.to_string()))?;
-                return Err(FileError::ChainMismatch {
-                    fields: differing_fields(&meta.chain, &want),
-                });
-            }
-        }
+        let expected = check_shapes(&meta, n_in)?;
+        let values = read_weights(data, &expected, n_in)?;
+        let (params, scales) = values.split_at(values.len() - n_in);
+        check_chain(&meta.chain, &chain, expected_chain)?;
         if meta.summary.kind != meta.kind {
-            return Err(malformed(format!(
+            return Err(FileError::Malformed(format!(
                 "training summary is for {}, the model is {}",
                 meta.summary.kind, meta.kind
             )));

@@ -28,6 +28,7 @@ mod optim;
 mod resdd;
 mod spec;
 mod split;
+mod summary;
 mod train;
 mod trained;
 mod traits;
@@ -45,6 +46,7 @@ pub use resdd::{ResDd, ResDdActivations, RESDD_INPUT_GAIN};
 pub use spec::{
     CnnSpec, LnSpec, MlpSpec, ModelSpec, ResDdSpec, ResDdVariant, MAX_MODULES, MAX_WIDTH,
 };
-pub use train::{train, EpochReport, TrainingSummary};
+pub use summary::TrainingSummary;
+pub use train::{train, EpochReport};
 pub use trained::{Predictor, TrainedModel};
 pub use traits::{Model, Scratch, TensorInfo, Trainable};

@@ -128,12 +128,7 @@ impl ResDd {
             scratch.buf.len() >= (1 + 2 * l) * h,
             "scratch too small for this ResDD"
         );
-        ResDdActivations {
-            h,
-            x: &scratch.buf[..h],
-            g: &scratch.buf[h..h + l * h],
-            a: &scratch.buf[h + l * h..h + 2 * l * h],
-        }
+        ResDdActivations::over(h, l, &scratch.buf)
     }
 
     fn split_params(&self) -> (&[f64], &[f64], &[f64]) {
@@ -215,56 +210,76 @@ impl Trainable for ResDd {
         let (g_mods, g_out) = rest.split_at_mut(l_count * h * h);
         // Forward activations [X, G_1..G_L, A_1..A_L], then the backward buffers.
         let (fwd, back) = scratch.buf.split_at_mut(h + 2 * l_count * h);
-        let (xh, rest) = fwd.split_at(h);
-        let (g_all, a_all) = rest.split_at(l_count * h);
-        let (d_a, rest) = back.split_at_mut(h);
-        let (d_prev, rest) = rest.split_at_mut(h);
-        let (d_g, rest) = rest.split_at_mut(h);
-        let d_x = &mut rest[..h];
-
-        let a_at = |l: usize| -> &[f64] {
-            if l == 0 {
-                xh
-            } else {
-                &a_all[(l - 1) * h..l * h]
-            }
+        let act = ResDdActivations::over(h, l_count, fwd);
+        let (a, rest) = back.split_at_mut(h);
+        let (prev, rest) = rest.split_at_mut(h);
+        let (g, rest) = rest.split_at_mut(h);
+        let mut d = Deltas {
+            a,
+            prev,
+            g,
+            x: &mut rest[..h],
         };
-        outer_acc(g_out, dy, a_at(l_count));
-        matvec_t(w_out, dy, d_a);
-        d_x.fill(0.0);
+
+        outer_acc(g_out, dy, act.a(l_count));
+        matvec_t(w_out, dy, d.a);
+        d.x.fill(0.0);
         for l in (1..=l_count).rev() {
-            let g = &g_all[(l - 1) * h..l * h];
-            let prev = a_at(l - 1);
-            let gate = match self.spec.variant {
-                ResDdVariant::InputGated => xh,
-                ResDdVariant::Chained => prev,
-            };
-            // A = G∘(M + 1): dG = dA∘(M + 1), dM = dA∘G.
-            for i in 0..h {
-                d_g[i] = d_a[i] * (gate[i] + 1.0);
-            }
-            let w = &w_mods[(l - 1) * h * h..l * h * h];
-            outer_acc(&mut g_mods[(l - 1) * h * h..l * h * h], d_g, prev);
-            matvec_t(w, d_g, d_prev);
-            match self.spec.variant {
-                ResDdVariant::InputGated => {
-                    for i in 0..h {
-                        d_x[i] += d_a[i] * g[i];
-                    }
-                }
-                ResDdVariant::Chained => {
-                    for i in 0..h {
-                        d_prev[i] += d_a[i] * g[i];
-                    }
-                }
-            }
-            d_a.copy_from_slice(d_prev);
+            let m = (l - 1) * h * h..l * h * h;
+            self.module_backward(&act, l, &w_mods[m.clone()], &mut g_mods[m], &mut d);
         }
         // A_0 = X.
-        for i in 0..h {
-            d_x[i] += d_a[i];
+        for (dx, da) in d.x.iter_mut().zip(d.a.iter()) {
+            *dx += da;
         }
-        outer_acc(g_in, d_x, x);
+        outer_acc(g_in, d.x, x);
+    }
+}
+
+/// The backward pass's work vectors, each `hidden` long.
+struct Deltas<'s> {
+    /// `dA_l` of the module being differentiated (on exit from a module: `dA_{l-1}`).
+    a: &'s mut [f64],
+    /// `dA_{l-1}` being built.
+    prev: &'s mut [f64],
+    /// `dG_l`.
+    g: &'s mut [f64],
+    /// `dX` collected so far.
+    x: &'s mut [f64],
+}
+
+impl ResDd {
+    /// Back through module `l` (weights `w`, their gradient `g_w`): from `dA_l` in `d.a`,
+    /// accumulates `dW_l`, adds the gate's share to `dX` (input-gated) and leaves `dA_{l-1}` in
+    /// `d.a`.
+    fn module_backward(
+        &self,
+        act: &ResDdActivations<'_>,
+        l: usize,
+        w: &[f64],
+        g_w: &mut [f64],
+        d: &mut Deltas<'_>,
+    ) {
+        let g = act.g(l);
+        let prev = act.a(l - 1);
+        let gate = match self.spec.variant {
+            ResDdVariant::InputGated => act.x(),
+            ResDdVariant::Chained => prev,
+        };
+        // A = G∘(M + 1): dG = dA∘(M + 1), dM = dA∘G.
+        for ((dg, da), m) in d.g.iter_mut().zip(d.a.iter()).zip(gate) {
+            *dg = da * (m + 1.0);
+        }
+        outer_acc(g_w, d.g, prev);
+        matvec_t(w, d.g, d.prev);
+        let d_m: &mut [f64] = match self.spec.variant {
+            ResDdVariant::InputGated => &mut *d.x,
+            ResDdVariant::Chained => &mut *d.prev,
+        };
+        for ((dm, da), gi) in d_m.iter_mut().zip(d.a.iter()).zip(g) {
+            *dm += da * gi;
+        }
+        d.a.copy_from_slice(d.prev);
     }
 }
 
@@ -278,6 +293,16 @@ pub struct ResDdActivations<'s> {
 }
 
 impl<'s> ResDdActivations<'s> {
+    /// The view of `buf` laid out as `[X, G_1..G_L, A_1..A_L]` for width `h` and `l` modules.
+    fn over(h: usize, l: usize, buf: &'s [f64]) -> Self {
+        ResDdActivations {
+            h,
+            x: &buf[..h],
+            g: &buf[h..h + l * h],
+            a: &buf[h + l * h..h + 2 * l * h],
+        }
+    }
+
     /// The projected input `X = W_in·x`.
     pub fn x(&self) -> &'s [f64] {
         self.x

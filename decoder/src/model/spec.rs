@@ -3,6 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::dsp::FEATURES_PER_CHANNEL;
+
 use super::error::ModelError;
 
 /// Which quantity a ResDD module multiplies its gate `G_l` by.
@@ -67,7 +69,7 @@ impl Default for MlpSpec {
 /// electrode) is a sequence of electrodes with the features as input channels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub struct CnnSpec {
-    /// Features per electrode (8 for the project's feature set).
+    /// Features per electrode ([`FEATURES_PER_CHANNEL`] for the project's feature set).
     pub features_per_channel: usize,
     /// Filters of the first and second convolution.
     pub filters: [usize; 2],
@@ -80,7 +82,7 @@ pub struct CnnSpec {
 impl Default for CnnSpec {
     fn default() -> Self {
         CnnSpec {
-            features_per_channel: 8,
+            features_per_channel: FEATURES_PER_CHANNEL,
             filters: [16, 16],
             kernel: 3,
             dense: 64,

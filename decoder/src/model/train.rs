@@ -6,10 +6,8 @@
 
 use std::time::Instant;
 
-use serde::{Deserialize, Serialize};
-
 use super::any::AnyModel;
-use super::config::TrainConfig;
+use super::config::{Optimizer, TrainConfig};
 use super::dataset::{Dataset, N_FINGERS};
 use super::error::TrainError;
 use super::init::SeededRng;
@@ -17,7 +15,8 @@ use super::kind::ModelKind;
 use super::normalizer::Normalizer;
 use super::optim::OptimState;
 use super::spec::ModelSpec;
-use super::split::make_split;
+use super::split::{make_split, Split};
+use super::summary::TrainingSummary;
 use super::trained::TrainedModel;
 use super::traits::{Model, Scratch, Trainable};
 
@@ -37,70 +36,101 @@ pub struct EpochReport {
     pub best_epoch: usize,
 }
 
-/// What training did; stored in the model file.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct TrainingSummary {
-    /// Architecture trained.
-    pub kind: ModelKind,
-    /// Settings used.
-    pub config: TrainConfig,
-    /// Epochs run.
-    pub epochs_run: usize,
-    /// Epoch whose weights were kept.
-    pub best_epoch: usize,
-    /// Whether early stopping ended training before `max_epochs`.
-    pub stopped_early: bool,
-    /// Training loss of the last epoch run.
-    pub final_train_loss: f64,
-    /// Validation loss of the kept weights (None without a split).
-    pub best_val_loss: Option<f64>,
-    /// Training windows.
-    pub n_train_windows: usize,
-    /// Held-out windows.
-    pub n_val_windows: usize,
-    /// Distinct trials in the training part.
-    pub n_train_trials: usize,
-    /// Distinct trials in the held-out part.
-    pub n_val_trials: usize,
-    /// Wall-clock training time in milliseconds (informative only; never affects results).
-    pub duration_ms: u64,
+/// The dataset with every window's features normalized once, before the first epoch.
+struct Normalized<'d> {
+    data: &'d Dataset,
+    xn: Vec<f64>,
 }
 
-impl TrainingSummary {
-    /// The summary of a model that was never trained (random weights, for tests, benchmarks
-    /// and tools that build a [`TrainedModel`] by hand).
-    pub fn untrained(kind: ModelKind) -> Self {
-        TrainingSummary {
-            kind,
-            config: TrainConfig::default(),
-            epochs_run: 0,
-            best_epoch: 0,
-            stopped_early: false,
-            final_train_loss: 0.0,
-            best_val_loss: None,
-            n_train_windows: 0,
-            n_val_windows: 0,
-            n_train_trials: 0,
-            n_val_trials: 0,
-            duration_ms: 0,
+impl<'d> Normalized<'d> {
+    fn new(data: &'d Dataset, normalizer: &Normalizer) -> Self {
+        let nf = data.n_features();
+        let mut xn = vec![0.0; data.len() * nf];
+        for (i, out) in xn.chunks_exact_mut(nf).enumerate() {
+            normalizer.apply(data.row(i), out);
+        }
+        Normalized { data, xn }
+    }
+
+    /// Normalized features of window `i`.
+    fn x(&self, i: usize) -> &[f64] {
+        let nf = self.data.n_features();
+        &self.xn[i * nf..(i + 1) * nf]
+    }
+}
+
+/// What the mini-batch steps reuse: optimizer state, the gradient, and the buffers of the
+/// forward and backward passes.
+struct Workspace {
+    opt: OptimState,
+    grad: Vec<f64>,
+    scratch: Scratch,
+    y: [f64; N_FINGERS],
+    dy: [f64; N_FINGERS],
+}
+
+impl Workspace {
+    fn new(model: &AnyModel, optimizer: Optimizer) -> Self {
+        let n_params = model.params().len();
+        Workspace {
+            opt: OptimState::new(optimizer, n_params),
+            grad: vec![0.0; n_params],
+            scratch: model.new_scratch(),
+            y: [0.0; N_FINGERS],
+            dy: [0.0; N_FINGERS],
         }
     }
 }
 
-/// Masked MSE of `model` over windows `idx` (normalized features in `xn`).
-fn masked_mse(
-    model: &AnyModel,
-    data: &Dataset,
-    xn: &[f64],
-    idx: &[usize],
-    scratch: &mut Scratch,
-) -> f64 {
-    let nf = data.n_features();
+/// The weights with the lowest validation loss so far, for early stopping.
+struct Best {
+    params: Vec<f64>,
+    val: f64,
+    epoch: usize,
+    /// Epochs since the last improvement.
+    since: usize,
+}
+
+impl Best {
+    fn new(params: &[f64]) -> Self {
+        Best {
+            params: params.to_vec(),
+            val: f64::INFINITY,
+            epoch: 0,
+            since: 0,
+        }
+    }
+
+    /// Records an epoch's validation loss; keeps its weights if it beats the best by more
+    /// than `min_delta`.
+    fn observe(&mut self, epoch: usize, val: f64, params: &[f64], min_delta: f64) {
+        if val < self.val - min_delta {
+            self.val = val;
+            self.epoch = epoch;
+            self.since = 0;
+            self.params.copy_from_slice(params);
+        } else {
+            self.since += 1;
+        }
+    }
+}
+
+/// How the epochs went, for the [`TrainingSummary`].
+struct Outcome {
+    epochs_run: usize,
+    best_epoch: usize,
+    stopped_early: bool,
+    final_train_loss: f64,
+    best_val_loss: Option<f64>,
+}
+
+/// Masked MSE of `model` over windows `idx`.
+fn masked_mse(model: &AnyModel, set: &Normalized<'_>, idx: &[usize], scratch: &mut Scratch) -> f64 {
     let mut y = [0.0; N_FINGERS];
     let (mut sum, mut count) = (0.0, 0usize);
     for &i in idx {
-        model.predict_with(&xn[i * nf..(i + 1) * nf], &mut y, scratch);
-        let (t, m) = (data.target(i), data.mask(i));
+        model.predict_with(set.x(i), &mut y, scratch);
+        let (t, m) = (set.data.target(i), set.data.mask(i));
         for f in 0..N_FINGERS {
             if m[f] {
                 let e = y[f] - t[f];
@@ -123,6 +153,129 @@ fn distinct_trials(data: &Dataset, idx: &[usize]) -> usize {
     t.len()
 }
 
+/// Refuses what cannot be trained: invalid settings, no windows, no unmasked target.
+fn check_inputs(data: &Dataset, cfg: &TrainConfig) -> Result<(), TrainError> {
+    cfg.validate()?;
+    if data.is_empty() {
+        return Err(TrainError::EmptyDataset);
+    }
+    if data.n_targets() == 0 {
+        return Err(TrainError::AllMasked);
+    }
+    Ok(())
+}
+
+/// Puts the gradient of the batch's masked MSE into `ws.grad` (`inv` is one over the batch's
+/// unmasked target count) and adds the batch's squared errors to `loss_sum`.
+fn batch_gradient(
+    model: &AnyModel,
+    set: &Normalized<'_>,
+    batch: &[usize],
+    inv: f64,
+    ws: &mut Workspace,
+    loss_sum: &mut f64,
+) {
+    ws.grad.fill(0.0);
+    for &i in batch {
+        let x = set.x(i);
+        model.predict_with(x, &mut ws.y, &mut ws.scratch);
+        let (t, m) = (set.data.target(i), set.data.mask(i));
+        for f in 0..N_FINGERS {
+            if m[f] {
+                let e = ws.y[f] - t[f];
+                *loss_sum += e * e;
+                ws.dy[f] = 2.0 * e * inv;
+            } else {
+                ws.dy[f] = 0.0;
+            }
+        }
+        model.backward(x, &ws.dy, &mut ws.scratch, &mut ws.grad);
+    }
+}
+
+/// One pass over the training windows in `order`, one optimizer step per mini-batch. Returns
+/// the mean masked squared error seen during the pass.
+fn run_epoch(
+    model: &mut AnyModel,
+    set: &Normalized<'_>,
+    order: &[usize],
+    batch_size: usize,
+    ws: &mut Workspace,
+) -> f64 {
+    let (mut loss_sum, mut loss_count) = (0.0, 0usize);
+    for batch in order.chunks(batch_size) {
+        let count: usize = batch
+            .iter()
+            .map(|&i| set.data.mask(i).iter().filter(|&&m| m).count())
+            .sum();
+        if count == 0 {
+            continue;
+        }
+        batch_gradient(model, set, batch, 1.0 / count as f64, ws, &mut loss_sum);
+        loss_count += count;
+        ws.opt.step(model.params_mut(), &ws.grad);
+    }
+    loss_sum / loss_count.max(1) as f64
+}
+
+/// Runs epochs until `max_epochs` or early stopping, calling `progress` after each, and leaves
+/// the kept weights in `model`: the best on the held-out windows, or the last without a split.
+fn run_epochs(
+    model: &mut AnyModel,
+    set: &Normalized<'_>,
+    split: &Split,
+    cfg: &TrainConfig,
+    rng: &mut SeededRng,
+    progress: &mut dyn FnMut(EpochReport),
+) -> Result<Outcome, TrainError> {
+    let mut ws = Workspace::new(model, cfg.optimizer);
+    let mut order = split.train.clone();
+    let has_val = !split.val.is_empty();
+    let mut best = Best::new(model.params());
+    let (mut epochs_run, mut final_train_loss, mut stopped_early) = (0, f64::NAN, false);
+    for epoch in 1..=cfg.max_epochs {
+        rng.shuffle(&mut order);
+        let train_loss = run_epoch(model, set, &order, cfg.batch_size, &mut ws);
+        epochs_run = epoch;
+        final_train_loss = train_loss;
+        if !train_loss.is_finite() || model.params().iter().any(|p| !p.is_finite()) {
+            return Err(TrainError::Diverged { epoch });
+        }
+        let val_loss = if has_val {
+            let v = masked_mse(model, set, &split.val, &mut ws.scratch);
+            if !v.is_finite() {
+                return Err(TrainError::Diverged { epoch });
+            }
+            best.observe(epoch, v, model.params(), cfg.min_delta);
+            Some(v)
+        } else {
+            best.epoch = epoch;
+            None
+        };
+        progress(EpochReport {
+            epoch,
+            max_epochs: cfg.max_epochs,
+            train_loss,
+            val_loss,
+            best_epoch: best.epoch,
+        });
+        if has_val && best.since >= cfg.patience {
+            stopped_early = epoch < cfg.max_epochs;
+            break;
+        }
+    }
+    if has_val {
+        model.params_mut().copy_from_slice(&best.params);
+    }
+    Ok(Outcome {
+        epochs_run,
+        best_epoch: best.epoch,
+        stopped_early,
+        final_train_loss,
+        best_val_loss: has_val.then_some(best.val),
+    })
+}
+
 /// Trains a model of `kind` (using `spec`'s block for it) on `data`.
 ///
 /// The normalizer is fitted on the training part of the split only. With a split, the weights
@@ -137,13 +290,7 @@ pub fn train(
     progress: &mut dyn FnMut(EpochReport),
 ) -> Result<TrainedModel, TrainError> {
     let started = Instant::now();
-    cfg.validate()?;
-    if data.is_empty() {
-        return Err(TrainError::EmptyDataset);
-    }
-    if data.n_targets() == 0 {
-        return Err(TrainError::AllMasked);
-    }
+    check_inputs(data, cfg)?;
     let mut rng = SeededRng::new(cfg.seed);
     let split = make_split(data, cfg.split, &mut rng)?;
     if split
@@ -155,107 +302,17 @@ pub fn train(
     }
     let nf = data.n_features();
     let normalizer = Normalizer::fit(nf, split.train.iter().map(|&i| data.row(i)))?;
-    let mut xn = vec![0.0; data.len() * nf];
-    for (i, out) in xn.chunks_exact_mut(nf).enumerate() {
-        normalizer.apply(data.row(i), out);
-    }
-
+    let set = Normalized::new(data, &normalizer);
     let mut model = AnyModel::init(kind, spec, nf, N_FINGERS, &mut rng)?;
-    let n_params = model.params().len();
-    let mut opt = OptimState::new(cfg.optimizer, n_params);
-    let mut grad = vec![0.0; n_params];
-    let mut scratch = model.new_scratch();
-    let mut order = split.train.clone();
-    let mut y = [0.0; N_FINGERS];
-    let mut dy = [0.0; N_FINGERS];
-
-    let has_val = !split.val.is_empty();
-    let mut best_params = model.params().to_vec();
-    let mut best_val = f64::INFINITY;
-    let mut best_epoch = 0;
-    let mut since_best = 0;
-    let mut epochs_run = 0;
-    let mut final_train_loss = f64::NAN;
-    let mut stopped_early = false;
-
-    for epoch in 1..=cfg.max_epochs {
-        rng.shuffle(&mut order);
-        let (mut loss_sum, mut loss_count) = (0.0, 0usize);
-        for batch in order.chunks(cfg.batch_size) {
-            let count: usize = batch
-                .iter()
-                .map(|&i| data.mask(i).iter().filter(|&&m| m).count())
-                .sum();
-            if count == 0 {
-                continue;
-            }
-            let inv = 1.0 / count as f64;
-            grad.fill(0.0);
-            for &i in batch {
-                let x = &xn[i * nf..(i + 1) * nf];
-                model.predict_with(x, &mut y, &mut scratch);
-                let (t, m) = (data.target(i), data.mask(i));
-                for f in 0..N_FINGERS {
-                    if m[f] {
-                        let e = y[f] - t[f];
-                        loss_sum += e * e;
-                        dy[f] = 2.0 * e * inv;
-                    } else {
-                        dy[f] = 0.0;
-                    }
-                }
-                model.backward(x, &dy, &mut scratch, &mut grad);
-            }
-            loss_count += count;
-            opt.step(model.params_mut(), &grad);
-        }
-        let train_loss = loss_sum / loss_count.max(1) as f64;
-        epochs_run = epoch;
-        final_train_loss = train_loss;
-        if !train_loss.is_finite() || model.params().iter().any(|p| !p.is_finite()) {
-            return Err(TrainError::Diverged { epoch });
-        }
-        let val_loss = if has_val {
-            let v = masked_mse(&model, data, &xn, &split.val, &mut scratch);
-            if !v.is_finite() {
-                return Err(TrainError::Diverged { epoch });
-            }
-            if v < best_val - cfg.min_delta {
-                best_val = v;
-                best_epoch = epoch;
-                since_best = 0;
-                best_params.copy_from_slice(model.params());
-            } else {
-                since_best += 1;
-            }
-            Some(v)
-        } else {
-            best_epoch = epoch;
-            None
-        };
-        progress(EpochReport {
-            epoch,
-            max_epochs: cfg.max_epochs,
-            train_loss,
-            val_loss,
-            best_epoch,
-        });
-        if has_val && since_best >= cfg.patience {
-            stopped_early = epoch < cfg.max_epochs;
-            break;
-        }
-    }
-    if has_val {
-        model.params_mut().copy_from_slice(&best_params);
-    }
+    let outcome = run_epochs(&mut model, &set, &split, cfg, &mut rng, progress)?;
     let summary = TrainingSummary {
         kind,
         config: *cfg,
-        epochs_run,
-        best_epoch,
-        stopped_early,
-        final_train_loss,
-        best_val_loss: has_val.then_some(best_val),
+        epochs_run: outcome.epochs_run,
+        best_epoch: outcome.best_epoch,
+        stopped_early: outcome.stopped_early,
+        final_train_loss: outcome.final_train_loss,
+        best_val_loss: outcome.best_val_loss,
         n_train_windows: split.train.len(),
         n_val_windows: split.val.len(),
         n_train_trials: distinct_trials(data, &split.train),

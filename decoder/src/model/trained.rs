@@ -8,7 +8,7 @@ use super::dataset::N_FINGERS;
 use super::error::ModelError;
 use super::normalizer::Normalizer;
 use super::spec::ModelSpec;
-use super::train::TrainingSummary;
+use super::summary::TrainingSummary;
 use super::traits::{Model, Scratch, Trainable};
 
 /// Model + normalizer + chain configuration + training summary (what a model file holds).
@@ -23,7 +23,8 @@ pub struct TrainedModel {
 
 impl TrainedModel {
     /// Bundles the parts, checking that they fit together: 5 outputs, the model's tensors match
-    /// `spec`, and model input = normalizer length = 8 × the chain's channels.
+    /// `spec`, and model input = normalizer length = [`FEATURES_PER_CHANNEL`] × the chain's
+    /// channels.
     pub fn new(
         model: AnyModel,
         spec: ModelSpec,
@@ -43,7 +44,11 @@ impl TrainedModel {
                 })
             }
         };
-        shape("model inputs (8 x chain channels)", n_in, model.n_inputs())?;
+        shape(
+            &format!("model inputs ({FEATURES_PER_CHANNEL} x chain channels)"),
+            n_in,
+            model.n_inputs(),
+        )?;
         shape("normalizer length", n_in, normalizer.len())?;
         shape("model outputs (fingers)", N_FINGERS, model.n_outputs())?;
         let expected = AnyModel::expected_tensors(model.kind(), &spec, n_in, N_FINGERS)?;

@@ -14,7 +14,7 @@ use super::error::SessionError;
 use super::trial::TrialKind;
 use super::windows::WindowOptions;
 use super::Session;
-use crate::eval::FEATURES_PER_CHANNEL;
+use crate::dsp::FEATURES_PER_CHANNEL;
 
 /// Thresholds of the gates.
 #[derive(Debug, Clone, Copy, PartialEq)]
