@@ -7,9 +7,9 @@
 
 use std::fmt;
 use std::fs;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use decoder::fsio::write_atomic;
 use serde::{Deserialize, Serialize};
 
 use crate::conditioner::FingerGains;
@@ -55,6 +55,9 @@ pub enum ConfigError {
         #[source]
         source: std::io::Error,
     },
+    /// The file could not be replaced atomically.
+    #[error(transparent)]
+    Write(#[from] decoder::fsio::WriteError),
     /// The file is not valid TOML or has unknown or mistyped fields.
     #[error("{path}: {message}")]
     Parse {
@@ -232,7 +235,7 @@ impl Default for Config {
     fn default() -> Self {
         Self {
             interface: "can0".into(),
-            model: PathBuf::from("/var/lib/handstack/model.json"),
+            model: PathBuf::from("/var/lib/handstack/model.hsm"),
             tick_ms: 50,
             deadline_slack_ms: 5,
             mains_hz: 50,
@@ -368,45 +371,13 @@ impl Config {
         toml::to_string_pretty(self).expect("a Config always serialises to TOML")
     }
 
-    /// Validate, then save atomically: write a temp file beside the target, fsync it, rename it
-    /// over the target, fsync the directory. A crash at any point leaves either the old or the
+    /// Validate, then save atomically ([`decoder::fsio::write_atomic`]): write a temp file
+    /// beside the target, fsync it, rename it over the target, fsync the directory. A crash at any point leaves either the old or the
     /// new file, never a mix.
     pub fn save_atomic(&self, path: &Path) -> Result<(), ConfigError> {
         self.validate()?;
-        write_atomic(path, self.to_toml().as_bytes()).map_err(|source| ConfigError::Io {
-            path: path.to_owned(),
-            source,
-        })
+        Ok(write_atomic(path, self.to_toml().as_bytes())?)
     }
-}
-
-/// Write `bytes` to `path` atomically (temp file in the same directory, fsync, rename, fsync of
-/// the directory).
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
-        _ => PathBuf::from("."),
-    };
-    let name = path
-        .file_name()
-        .ok_or_else(|| std::io::Error::new(std::io::ErrorKind::InvalidInput, "no file name"))?;
-    let tmp = dir.join(format!(
-        ".{}.tmp.{}",
-        name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = (|| {
-        let mut f = fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        drop(f);
-        fs::rename(&tmp, path)?;
-        fs::File::open(&dir)?.sync_all()
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result
 }
 
 impl fmt::Display for FingerConfig {

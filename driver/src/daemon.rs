@@ -11,8 +11,8 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::Receiver;
 use std::sync::{Arc, Mutex};
 
+use hand_clock::Clock;
 use hand_dbc::CanFrame;
-use hand_model::Clock;
 
 use crate::conditioner::{FingerGains, Setpoint};
 use crate::engine::{Command, Counters, Engine};

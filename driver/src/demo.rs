@@ -1,4 +1,4 @@
-//! The embedded demo, in one process over the in-memory bus: the simulated patient is
+//! The embedded demo (feature `sim`), in one process over the in-memory bus: the simulated patient is
 //! calibrated (rest, maximal flexion and extension of each finger and of the whole hand),
 //! ResDD is trained on that session, then the real daemon loop drives the simulated hand
 //! while the simulated patient tracks a sine with the index finger. Tracking is scored on the
@@ -14,6 +14,7 @@ use std::time::Duration;
 use decoder::eval::tracking_metrics;
 use decoder::model::{train, EpochReport, ModelKind, ModelSpec, TrainConfig, TrainedModel};
 use decoder::session::{check_gates, GateConfig, Session, WindowOptions};
+use hand_clock::{Clock, SystemClock, VirtualClock};
 use hand_dbc::candump::LogWriter;
 use hand_dbc::messages::FingerStatus;
 use hand_model::emg::AmplifierConfig;
@@ -21,13 +22,13 @@ use hand_model::nodes::AmplifierNodeConfig;
 use hand_model::patient::TrackingConfig;
 use hand_model::record::run_on_mem_bus;
 use hand_model::world::{PatientMode, World, WorldConfig};
-use hand_model::{Clock, MemBus, Scenario, SystemClock, VirtualClock};
+use hand_model::{MemBus, Scenario};
 
 use crate::config::Config;
 use crate::daemon::{Runner, Snapshot};
 use crate::engine::Engine;
+use crate::mem_transport::MemTransport;
 use crate::startup::engine_settings;
-use crate::transport::MemTransport;
 
 /// Settings of a demo run.
 #[derive(Debug, Clone)]
@@ -150,7 +151,7 @@ pub fn record_calibration(dir: &Path, seed: u64) -> Result<usize, DemoError> {
         seed,
         ..AmplifierConfig::default()
     };
-    let meta = run.session_toml("frames.log", &signal)?;
+    let meta = run.session_meta("frames.log", &signal);
     let log_path = dir.join("frames.log");
     let file = std::fs::File::create(&log_path).map_err(io(&log_path))?;
     let mut log = LogWriter::new(std::io::BufWriter::new(file));
@@ -166,8 +167,7 @@ pub fn record_calibration(dir: &Path, seed: u64) -> Result<usize, DemoError> {
     })?
     .map_err(io(&log_path))?;
     log.flush().map_err(io(&log_path))?;
-    let meta_path = dir.join("session.toml");
-    std::fs::write(&meta_path, meta).map_err(io(&meta_path))?;
+    meta.write(dir)?;
     Ok(run.trials.len())
 }
 

@@ -1,12 +1,20 @@
 //! The product: the `handd` daemon (the 50 ms control loop, its safety state machine and
-//! transports) and the technician CLI `handctl`.
+//! transports) and the technician CLI `handctl` ([`cli`]).
+//!
+//! Features (none by default, which is the daemon's build): `sim` adds the demo and the
+//! in-memory transport on the simulator (`hand-model`); `plots` lets `handctl eval` draw PNG
+//! figures (the plotting stack). `handd` needs neither and links neither.
 
+pub mod cli;
 pub mod conditioner;
 pub mod config;
 pub mod control;
 pub mod daemon;
+#[cfg(feature = "sim")]
 pub mod demo;
 pub mod engine;
+#[cfg(feature = "sim")]
+pub mod mem_transport;
 pub mod protocol;
 pub mod rt;
 pub mod safety;

@@ -10,8 +10,8 @@
 use std::path::Path;
 use std::time::{SystemTime, UNIX_EPOCH};
 
+use hand_clock::Clock;
 use hand_dbc::CanFrame;
-use hand_model::Clock;
 use socketcan::{CanSocket, EmbeddedFrame, Socket, SocketOptions};
 
 use crate::transport::{Timestamped, Transport, TransportError};
@@ -170,7 +170,7 @@ mod tests {
 
     #[test]
     fn a_missing_interface_says_how_to_create_it() {
-        let e = SocketCanTransport::open("nosuchcan9", hand_model::SystemClock::new())
+        let e = SocketCanTransport::open("nosuchcan9", hand_clock::SystemClock::new())
             .err()
             .expect("no such interface here");
         let msg = e.to_string();

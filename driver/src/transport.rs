@@ -1,14 +1,13 @@
 //! How the daemon reaches the bus. The control logic ([`crate::engine`]) sees frames and
 //! times only; a [`Transport`] delivers received frames with their receive time and sends
-//! frames, and reports the bus's health as errors. Backends: the in-memory bus of `hand-model`
-//! (with its own per-frame receive times) and SocketCAN ([`crate::socketcan_bus`], kernel
-//! receive timestamps).
+//! frames, and reports the bus's health as errors. Backends: SocketCAN
+//! ([`crate::socketcan_bus`], kernel receive timestamps) and, with the `sim` feature, the
+//! in-memory bus of `hand-model` (`crate::mem_transport`, its own per-frame receive times).
 //!
 //! Receive times must be each frame's own: a transport that stamped a whole batch with the
 //! time it was read would make the EMG reassembler see 50 ms gaps between batches.
 
 use hand_dbc::CanFrame;
-use hand_model::{Clock, MemBusError, MemEndpoint};
 
 /// Why the bus cannot be used.
 #[derive(Debug, thiserror::Error)]
@@ -41,41 +40,4 @@ pub trait Transport {
     fn drop_queued(&mut self);
     /// Try to bring the bus back (reopen the socket).
     fn reopen(&mut self) -> Result<(), TransportError>;
-}
-
-/// The in-memory bus: receive times come from the bus's clock, or from `clock` if it has none.
-pub struct MemTransport<K: Clock> {
-    endpoint: MemEndpoint<CanFrame>,
-    clock: K,
-}
-
-impl<K: Clock> MemTransport<K> {
-    /// Wraps an endpoint.
-    pub fn new(endpoint: MemEndpoint<CanFrame>, clock: K) -> Self {
-        Self { endpoint, clock }
-    }
-}
-
-impl<K: Clock> Transport for MemTransport<K> {
-    fn try_recv(&mut self) -> Result<Option<Timestamped>, TransportError> {
-        Ok(self
-            .endpoint
-            .receive_timestamped()
-            .map(|r| (r.frame, r.time_us.unwrap_or_else(|| self.clock.now_us()))))
-    }
-
-    fn send(&mut self, frame: &CanFrame) -> Result<(), TransportError> {
-        self.endpoint.send(frame).map_err(|e| match e {
-            MemBusError::BusOff => TransportError::BusOff,
-            other => TransportError::Down(other.to_string()),
-        })
-    }
-
-    fn drop_queued(&mut self) {
-        // The in-memory bus delivers at once: nothing is ever queued for sending.
-    }
-
-    fn reopen(&mut self) -> Result<(), TransportError> {
-        Ok(())
-    }
 }

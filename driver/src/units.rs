@@ -13,6 +13,13 @@ pub struct RadPerSec(pub f64);
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Default)]
 pub struct RadPerSec2(pub f64);
 
+// single source: hand_dbc::hand (N_FINGERS, FINGER_NAMES, finger_index, ADC_MIN, ADC_MAX are
+// being added to the codec crate; switch these to re-exports of it at the merge).
+
+/// Largest raw EMG value of the amplifier's signed 12-bit ADC, in bus LSB: where the bus's EMG
+/// signals saturate (a recorded session's `full_scale`).
+pub const ADC_MAX: i16 = 2047;
+
 /// Number of fingers of the hand: 0 thumb, 1 index, 2 middle, 3 ring, 4 pinky.
 pub const N_FINGERS: usize = 5;
 

@@ -46,7 +46,7 @@ fn import_train_and_eval_on_the_3dc_proxy() {
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(session.join("session.toml").exists());
 
-    let model = session.join("resdd.model");
+    let model = session.join("resdd.hsm");
     let out = handctl(&[
         "train",
         s(&session),
@@ -88,14 +88,28 @@ fn import_train_and_eval_on_the_3dc_proxy() {
         o.lines().any(|l| l.starts_with("resdd ")) && o.lines().any(|l| l.starts_with("ln ")),
         "{o}"
     );
+    for name in ["resdd", "ln"] {
+        let roc = std::fs::read_to_string(plots.join(format!("roc_{name}.csv"))).unwrap();
+        assert!(roc.starts_with("finger,auc,fpr,tpr\n") && roc.lines().count() > 10);
+        let f = format!("interpolation_{name}.csv");
+        let curves = std::fs::read_to_string(plots.join(&f)).unwrap();
+        assert!(curves.starts_with("curve,finger,sign,"), "{f}");
+    }
+    // PNG figures only from a handctl built with the plotting stack.
     for f in [
         "roc_resdd.png",
         "interpolation_resdd.png",
         "roc_ln.png",
         "interpolation_ln.png",
     ] {
-        let bytes = std::fs::read(plots.join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
-        assert_eq!(&bytes[..4], b"\x89PNG", "{f}");
+        let png = std::fs::read(plots.join(f));
+        if cfg!(feature = "plots") {
+            let bytes = png.unwrap_or_else(|e| panic!("{f}: {e}"));
+            assert_eq!(&bytes[..4], b"\x89PNG", "{f}");
+        } else {
+            assert!(png.is_err(), "{f} written without the plots feature");
+            assert!(o.contains("--features plots"), "{o}");
+        }
     }
     // Without --test, the last repetitions are held out.
     let out = handctl(&["eval", s(&session), "--models", "ln", "--epochs", "3"]);
@@ -110,7 +124,7 @@ fn import_train_and_eval_on_the_3dc_proxy() {
 
 #[test]
 fn errors_are_clear() {
-    let out = handctl(&["train", "/nonexistent/session", "-o", "/tmp/x.model"]);
+    let out = handctl(&["train", "/nonexistent/session", "-o", "/tmp/x.hsm"]);
     assert_eq!(out.status.code(), Some(1));
     let e = text(&out.stderr);
     assert!(
@@ -135,7 +149,7 @@ fn errors_are_clear() {
     assert_eq!(out.status.code(), Some(2), "clap usage error");
     assert!(text(&out.stderr).contains("transformer"));
 
-    let out = handctl(&["train", "3dc:/nowhere:validation", "-o", "/tmp/x.model"]);
+    let out = handctl(&["train", "3dc:/nowhere:validation", "-o", "/tmp/x.hsm"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(
         text(&out.stderr).contains("validation"),
@@ -207,7 +221,7 @@ fn import_an_npy_recording_with_a_label_table_and_train_on_it() {
         text(&out.stdout),
         text(&out.stderr)
     );
-    let model = dir.join("m.model");
+    let model = dir.join("m.hsm");
     let out = handctl(&[
         "train",
         s(&session),
@@ -239,4 +253,25 @@ fn import_an_npy_recording_with_a_label_table_and_train_on_it() {
         text(&out.stderr)
     );
     std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn the_demo_says_how_to_build_it_and_socket_failures_are_not_usage_errors() {
+    if !cfg!(feature = "sim") {
+        let out = handctl(&["demo", "--fast"]);
+        assert_eq!(out.status.code(), Some(1));
+        let e = text(&out.stderr);
+        assert!(
+            e.contains("cargo run --release --features sim --bin handctl -- demo"),
+            "{e}"
+        );
+    }
+    let dir = tmp("nosocket");
+    let out = handctl(&["status", "--socket", s(&dir.join("handctl.sock"))]);
+    assert_eq!(out.status.code(), Some(1));
+    let e = text(&out.stderr);
+    assert!(
+        e.contains("cannot talk to handd") && e.contains("handctl.sock"),
+        "{e}"
+    );
 }

@@ -1,16 +1,19 @@
 //! The simulated world on the bus: an sEMG amplifier node, finger motor-controller nodes and a
 //! simulated patient, so that the daemon can be calibrated, run and broken without a person or
-//! a prosthesis. It speaks hand.dbc through `hand-dbc` and nothing else: it never depends on
-//! the daemon.
+//! a prosthesis. It speaks hand.dbc through `hand-dbc`, keeps time with `hand-clock` and
+//! writes its calibration sessions with the decoder's session types; it never depends on the
+//! daemon, and the daemon never depends on it (only `driver`'s `sim` feature does).
 //!
 //! Map:
-//! - [`clock`]: [`Clock`], [`VirtualClock`] (tests), [`SystemClock`] (real time).
+//! - [`clock`]: [`Clock`], [`VirtualClock`] (tests), [`SystemClock`] (real time), re-exported
+//!   from `hand-clock`.
 //! - [`bus`]: [`MemBus`], an in-memory broadcast CAN bus whose endpoints implement
 //!   `embedded_can::nb::Can` and `blocking::Can`; [`socketcan_bus`] is the SocketCAN transport.
 //! - [`emg`]: the signal model: 10 muscle sources (flexor and extensor per finger), cross-talk
 //!   into 12 channels, mains, DC offset and drift, noise floor, 12-bit ADC.
 //! - [`patient`]: intents per finger, scripts (rest, holds, ramps, gestures), the calibration
-//!   protocol with its [`patient::CalibrationTrial`] metadata, and the closed-loop user.
+//!   protocol with its trials ([`patient::Trial`], the decoder's type), and the closed-loop
+//!   user.
 //! - [`finger`]: one finger's mechanics and control law.
 //! - [`nodes`]: the bus nodes, each stepped by `poll(now_us, &mut bus)`: amplifier, motor
 //!   controllers, fault injector, and a setpoint source standing in for the daemon in tests.

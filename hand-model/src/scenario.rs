@@ -2,13 +2,13 @@
 
 use std::str::FromStr;
 
-use serde::Serialize;
+use decoder::dsp::ChainConfig;
+use decoder::session::{SessionMeta, Trial, TrialTable};
 
 use crate::emg::{AmplifierConfig, ADC_MAX, N_CHANNELS};
 use crate::error::SimError;
 use crate::patient::{
-    CalibrationProtocol, CalibrationTrial, ClosedLoopUser, Gesture, Intent, Script, Target,
-    TrackingConfig,
+    CalibrationProtocol, ClosedLoopUser, Gesture, Intent, Script, Target, TrackingConfig,
 };
 use crate::world::PatientMode;
 
@@ -151,71 +151,28 @@ pub struct ScenarioRun {
     /// How long it runs, µs.
     pub duration_us: u64,
     /// Labelled trials (calibration scenarios; empty otherwise), times relative to the start.
-    pub trials: Vec<CalibrationTrial>,
-}
-
-#[derive(Serialize)]
-struct TrialDoc<'a> {
-    trial: &'a [CalibrationTrial],
-}
-
-/// `session.toml` as decoder::session reads it (format_version 1).
-#[derive(Serialize)]
-struct SessionDoc<'a> {
-    format_version: u32,
-    onset_skip_ms: f64,
-    chain: ChainDoc,
-    recording: RecordingDoc<'a>,
-    trial: &'a [CalibrationTrial],
-}
-
-#[derive(Serialize)]
-struct ChainDoc {
-    channels: usize,
-    sample_rate_hz: f64,
-    mains_hz: u32,
-}
-
-#[derive(Serialize)]
-struct RecordingDoc<'a> {
-    format: &'static str,
-    file: &'a str,
-    full_scale: f64,
+    pub trials: Vec<Trial>,
 }
 
 impl ScenarioRun {
     /// The trials as TOML `[[trial]]` tables (the session.toml form of contracts.md).
-    pub fn trials_toml(&self) -> Result<String, SimError> {
-        toml::to_string(&TrialDoc {
-            trial: &self.trials,
-        })
-        .map_err(|e| SimError::BadScript(format!("cannot serialise the trials: {e}")))
+    pub fn trials_toml(&self) -> String {
+        TrialTable {
+            trial: self.trials.clone(),
+        }
+        .to_toml()
     }
 
-    /// A whole `session.toml` for a candump recording `frames_file` of this run made with
-    /// `amp` (contracts.md session section; decoder::session format_version 1): the chain
-    /// basics (channels, rate, mains), the recording (candump, ADC full scale) and the trials.
-    pub fn session_toml(
-        &self,
-        frames_file: &str,
-        amp: &AmplifierConfig,
-    ) -> Result<String, SimError> {
-        let doc = SessionDoc {
-            format_version: 1,
-            onset_skip_ms: 0.0,
-            chain: ChainDoc {
-                channels: N_CHANNELS,
-                sample_rate_hz: amp.sample_rate_hz,
-                mains_hz: amp.mains.hz() as u32,
-            },
-            recording: RecordingDoc {
-                format: "candump",
-                file: frames_file,
-                full_scale: f64::from(ADC_MAX),
-            },
-            trial: &self.trials,
+    /// The `session.toml` of a candump recording `frames_file` of this run made with `amp`
+    /// (contracts.md session section; decoder::session format_version 1): the chain basics
+    /// (channels, rate, mains), the recording (candump, ADC full scale) and the trials.
+    pub fn session_meta(&self, frames_file: &str, amp: &AmplifierConfig) -> SessionMeta {
+        let chain = ChainConfig {
+            channels: N_CHANNELS,
+            sample_rate_hz: amp.sample_rate_hz,
+            mains_hz: amp.mains.hz() as u32,
+            ..ChainConfig::default()
         };
-        toml::to_string(&doc)
-            .map_err(|e| SimError::BadScript(format!("cannot serialise session.toml: {e}")))
+        SessionMeta::candump(chain, frames_file, f64::from(ADC_MAX), self.trials.clone())
     }
 }

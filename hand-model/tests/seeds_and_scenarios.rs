@@ -9,7 +9,7 @@ use hand_model::bus::MemEndpoint;
 use hand_model::dbc::CanFrame;
 use hand_model::emg::AmplifierConfig;
 use hand_model::nodes::{AmplifierNodeConfig, SetpointSource};
-use hand_model::patient::{CalibrationTrial, Intent, TrialKind};
+use hand_model::patient::{Intent, TrialKind};
 use hand_model::scenario::Scenario;
 use hand_model::world::{PatientMode, World, WorldConfig};
 
@@ -64,7 +64,7 @@ fn calibration_scenario_produces_the_trials() {
     // 5 fingers + whole hand, flexion and extension each, plus one rest trial.
     assert_eq!(run.trials.len(), 13);
     for (i, t) in run.trials.iter().enumerate() {
-        assert_eq!(t.id, i + 1);
+        assert_eq!(t.id as usize, i + 1);
         assert_eq!(t.repetition, 1);
         assert_eq!(t.end_us - t.start_us, 500_000);
         assert!(t.end_us <= run.duration_us);
@@ -90,22 +90,22 @@ fn calibration_scenario_produces_the_trials() {
     assert_eq!(full.trials.last().map(|t| t.repetition), Some(3));
 
     // The metadata round-trips through the session.toml form.
-    let text = run.trials_toml().expect("serialise");
+    let text = run.trials_toml();
     assert!(
         text.contains("[[trial]]") && text.contains("finger = \"all\""),
         "{text}"
     );
-    #[derive(serde::Deserialize)]
-    struct Doc {
-        trial: Vec<CalibrationTrial>,
-    }
-    let back: Doc = toml::from_str(&text).expect("parse");
+    let back = decoder::session::TrialTable::parse(&text).expect("parse");
     assert_eq!(back.trial, run.trials);
 
-    // The whole session.toml carries the chain basics and the recording next to the trials.
+    // The whole session.toml carries the chain basics and the recording next to the trials,
+    // and the decoder reads it back.
     let session = run
-        .session_toml("frames.log", &AmplifierConfig::default())
-        .expect("serialise");
+        .session_meta("frames.log", &AmplifierConfig::default())
+        .to_toml();
+    let meta = decoder::session::SessionMeta::parse(&session, std::path::Path::new("s.toml"))
+        .expect("decoder reads the simulator's session.toml");
+    assert_eq!(meta.trials, run.trials);
     let value: toml::Value = toml::from_str(&session).expect("parse");
     assert_eq!(value["format_version"].as_integer(), Some(1));
     assert_eq!(value["chain"]["channels"].as_integer(), Some(12));
@@ -121,7 +121,7 @@ fn calibration_scenario_produces_the_trials() {
     for t in &run.trials {
         let mid = (t.start_us + t.end_us) / 2;
         let intent = script.intent_at(mid);
-        let want = t.labels();
+        let want = t.targets();
         assert_eq!(intent, Intent(want), "trial {t:?}");
     }
 }

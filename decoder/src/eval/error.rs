@@ -27,6 +27,14 @@ pub enum EvalError {
     /// A model's output or a feature row does not have the expected width.
     #[error("{0}")]
     Shape(String),
+    /// Writing a table or curve file failed.
+    #[error("{path}: {source}")]
+    Write {
+        /// The file being written.
+        path: String,
+        /// What the OS said.
+        source: std::io::Error,
+    },
     /// Writing a plot failed.
     #[error("plot {path}: {message}")]
     Plot {

@@ -1,19 +1,22 @@
 //! Offline evaluation as in the paper: direction AUC with the Hanley-McNeil standard error and
 //! sign accuracy (Table 3), the interpolation analysis (Table 4), tracking metrics (RMSE, MAPE,
-//! R²), text tables and PNG figures.
+//! R²), text tables, the curves as CSV and (with the `plots` feature) PNG figures.
 //!
 //! The metric functions take plain slices and a prediction closure, so they know nothing of
 //! how a model was built; [`evaluate`] ties them to trained models and calibration sessions.
 
+mod csv;
 mod direction;
 mod error;
 mod evaluate;
 mod interpolation;
+#[cfg(feature = "plots")]
 mod plot;
 mod stats;
 mod table;
 mod tracking;
 
+pub use csv::{interpolation_csv, roc_csv, write_csv};
 pub use direction::{
     auc, direction_metrics, hanley_mcneil_se, roc_curve, sign_accuracy, DirectionMetrics, RocPoint,
 };
@@ -23,6 +26,7 @@ pub use interpolation::{
     interpolation_curves, judge_curve, scale_features, InterpolationConfig, InterpolationCurve,
     InterpolationInput, InterpolationSummary, VAR_INDEX,
 };
+#[cfg(feature = "plots")]
 pub use plot::{interpolation_png, roc_png};
 pub use stats::{average_ranks, linear_fit, pearson, spearman, LinearFit};
 pub use table::{direction_table, interpolation_table};

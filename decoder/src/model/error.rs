@@ -105,6 +105,16 @@ pub enum TrainError {
     Model(#[from] ModelError),
 }
 
+impl From<crate::fsio::WriteError> for FileError {
+    fn from(e: crate::fsio::WriteError) -> Self {
+        FileError::Io {
+            op: e.op,
+            path: e.path,
+            source: e.source,
+        }
+    }
+}
+
 /// A model file could not be written or read, or it does not fit the running configuration.
 #[derive(Debug, Error)]
 pub enum FileError {

@@ -19,13 +19,13 @@
 //! checksum, metadata, tensor shapes against the kind and spec, finite weights, the chain
 //! configuration against the one in use.
 
-use std::fs::{self, File};
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::fs;
+use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
 use crate::dsp::{ChainConfig, FEATURES_PER_CHANNEL, FEATURE_NAMES};
+use crate::fsio::write_atomic;
 
 use super::any::AnyModel;
 use super::dataset::N_FINGERS;
@@ -368,38 +368,13 @@ impl TrainedModel {
         )?)
     }
 
-    /// Writes the model atomically: a temporary file in the same directory, fsync, rename over
-    /// `path`, fsync of the directory. A crash leaves either the old file or the new one.
+    /// Writes the model atomically ([`crate::fsio::write_atomic`]: a temporary file in the same
+    /// directory, fsync, rename over `path`, fsync of the directory). A crash leaves either the
+    /// old file or the new one.
     pub fn save(&self, path: impl AsRef<Path>) -> Result<(), FileError> {
         let path = path.as_ref();
         let bytes = self.to_bytes()?;
-        let dir = match path.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let name = path
-            .file_name()
-            .ok_or_else(|| FileError::Malformed(format!("{} has no file name", path.display())))?;
-        let tmp = dir.join(format!(
-            ".{}.tmp-{}",
-            name.to_string_lossy(),
-            std::process::id()
-        ));
-        let write = || -> Result<(), FileError> {
-            let mut f = File::create(&tmp).map_err(io_err("create", &tmp))?;
-            f.write_all(&bytes).map_err(io_err("write", &tmp))?;
-            f.sync_all().map_err(io_err("fsync", &tmp))?;
-            fs::rename(&tmp, path).map_err(io_err("rename into", path))?;
-            File::open(&dir)
-                .and_then(|d| d.sync_all())
-                .map_err(io_err("fsync directory", &dir))
-        };
-        let result = write();
-        if result.is_err() {
-            // Best effort: never leave a stray temporary behind; the original error matters more.
-            let _ = fs::remove_file(&tmp);
-        }
-        result
+        Ok(write_atomic(path, &bytes)?)
     }
 
     /// Reads and checks a model file; see [`TrainedModel::from_bytes`].

@@ -13,6 +13,9 @@ pub enum SessionError {
         /// What the OS said.
         source: std::io::Error,
     },
+    /// A file could not be replaced atomically.
+    #[error(transparent)]
+    Write(#[from] crate::fsio::WriteError),
     /// `session.toml` is not valid TOML or does not have the expected fields (the message
     /// carries the line and column).
     #[error("{path}: {message}")]

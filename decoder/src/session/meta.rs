@@ -32,8 +32,9 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::error::SessionError;
-use super::trial::{Trial, TrialKind, FINGER_NAMES, N_FINGERS};
+use super::trial::{FingerField, Trial, TrialKind, N_FINGERS};
 use crate::dsp::ChainConfig;
+use crate::fsio::write_atomic;
 
 /// The `session.toml` format this code writes and reads.
 pub const FORMAT_VERSION: u32 = 1;
@@ -91,13 +92,6 @@ pub struct SessionMeta {
 }
 
 #[derive(Debug, Serialize, Deserialize)]
-#[serde(untagged)]
-enum FingerField {
-    Index(i64),
-    Name(String),
-}
-
-#[derive(Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct TrialFile {
     id: u32,
@@ -128,31 +122,33 @@ struct SessionFile {
     trials: Vec<TrialFile>,
 }
 
-fn parse_finger(f: &FingerField) -> Result<Option<usize>, String> {
-    match f {
-        FingerField::Index(i) if (0..N_FINGERS as i64).contains(i) => Ok(Some(*i as usize)),
-        FingerField::Index(i) => Err(format!(
-            "finger {i} is not 0..4 (0 thumb .. 4 pinky) or \"all\""
-        )),
-        FingerField::Name(s) => {
-            let s = s.trim().to_ascii_lowercase();
-            if s == "all" {
-                return Ok(None);
-            }
-            FINGER_NAMES
-                .iter()
-                .position(|n| *n == s)
-                .map(Some)
-                .ok_or_else(|| format!("finger \"{s}\" is not 0..4, a finger name or \"all\""))
-        }
-    }
-}
-
 fn us_of_sample(sample: u64, rate_hz: f64) -> u64 {
     (sample as f64 * 1e6 / rate_hz).round() as u64
 }
 
 impl SessionMeta {
+    /// The metadata of a recorded candump log `file` (relative to the session directory): the
+    /// bus's EMG signals saturate at `full_scale` LSB, no onset skip, one segment. The writer
+    /// of every recorded session (`handctl record`, the simulator's sessions, the demo).
+    pub fn candump(
+        chain: ChainConfig,
+        file: impl Into<PathBuf>,
+        full_scale: f64,
+        trials: Vec<Trial>,
+    ) -> Self {
+        SessionMeta {
+            chain,
+            onset_skip_ms: 0.0,
+            recording: RecordingSpec {
+                format: RecordingFormat::Candump,
+                file: file.into(),
+                full_scale: Some(full_scale),
+            },
+            segments: Vec::new(),
+            trials,
+        }
+    }
+
     /// Parses and checks the text of a `session.toml`; `path` is only used in messages.
     pub fn parse(text: &str, path: &Path) -> Result<Self, SessionError> {
         let file: SessionFile = toml::from_str(text).map_err(|e| SessionError::Toml {
@@ -173,7 +169,7 @@ impl SessionMeta {
         let mut trials = Vec::with_capacity(file.trials.len());
         for t in &file.trials {
             let bad = |m: String| SessionError::invalid(path, format!("trial {}: {m}", t.id));
-            let finger = parse_finger(&t.finger).map_err(bad)?;
+            let finger = t.finger.parse().map_err(bad)?;
             let (start_us, end_us) = match (t.start_us, t.end_us, t.start_sample, t.end_sample) {
                 (Some(s), Some(e), None, None) => (s, e),
                 (None, None, Some(s), Some(e)) => (us_of_sample(s, rate), us_of_sample(e, rate)),
@@ -291,10 +287,7 @@ impl SessionMeta {
                 .iter()
                 .map(|t| TrialFile {
                     id: t.id,
-                    finger: match t.finger {
-                        Some(f) => FingerField::Index(f as i64),
-                        None => FingerField::Name("all".into()),
-                    },
+                    finger: FingerField::of(t.finger),
                     kind: t.kind,
                     repetition: t.repetition,
                     start_us: Some(t.start_us),
@@ -315,10 +308,13 @@ impl SessionMeta {
         Self::parse(&text, &path)
     }
 
-    /// Writes `dir/session.toml` atomically (temporary file, fsync, rename).
+    /// Writes `dir/session.toml` atomically ([`crate::fsio::write_atomic`]).
     pub fn write(&self, dir: &Path) -> Result<(), SessionError> {
         std::fs::create_dir_all(dir).map_err(|e| SessionError::io(dir, e))?;
-        write_atomic(&dir.join(META_FILE), self.to_toml().as_bytes())
+        Ok(write_atomic(
+            &dir.join(META_FILE),
+            self.to_toml().as_bytes(),
+        )?)
     }
 
     /// The recording's file, resolved against the session directory.
@@ -329,15 +325,4 @@ impl SessionMeta {
             dir.join(&self.recording.file)
         }
     }
-}
-
-/// Writes a file so that a crash leaves either the old or the new contents, never a torn file.
-pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), SessionError> {
-    use std::io::Write;
-    let tmp = path.with_extension("tmp");
-    let mut f = std::fs::File::create(&tmp).map_err(|e| SessionError::io(&tmp, e))?;
-    f.write_all(bytes).map_err(|e| SessionError::io(&tmp, e))?;
-    f.sync_all().map_err(|e| SessionError::io(&tmp, e))?;
-    drop(f);
-    std::fs::rename(&tmp, path).map_err(|e| SessionError::io(path, e))
 }

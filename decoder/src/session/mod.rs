@@ -28,7 +28,7 @@ pub use import::{
 pub use meta::{RecordingFormat, RecordingSpec, Segment, SessionMeta, FORMAT_VERSION, META_FILE};
 pub use npy::{npy_f64_bytes, write_npy_f64};
 pub use recording::Recording;
-pub use trial::{Trial, TrialKind, FINGER_NAMES, N_FINGERS};
+pub use trial::{Trial, TrialKind, TrialTable, FINGER_NAMES, N_FINGERS};
 pub use windows::{LabelledWindows, WindowLabel, WindowOptions};
 
 /// A loaded session: its metadata and raw recording.

@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::error::SessionError;
-use super::meta::write_atomic;
+use crate::fsio::write_atomic;
 
 /// Encodes a row-major `rows x cols` float64 matrix as NPY v1.0 bytes.
 pub fn npy_f64_bytes(rows: usize, cols: usize, data: &[f64]) -> Vec<u8> {
@@ -38,7 +38,7 @@ pub fn write_npy_f64(
             format!("{} values is not {rows} x {cols}", data.len()),
         ));
     }
-    write_atomic(path, &npy_f64_bytes(rows, cols, data))
+    Ok(write_atomic(path, &npy_f64_bytes(rows, cols, data))?)
 }
 
 #[cfg(test)]

@@ -1,11 +1,7 @@
 //! `handctl`: the technician's command line for the hand: calibration training, evaluation,
-//! importing recordings, the running daemon's status, live tuning, arm and stop, and the demo.
-//! See `handctl --help`.
-
-// The CLI lives in driver/src/cli, one module per subcommand.
-#[path = "../cli/mod.rs"]
-mod cli;
+//! importing recordings, the running daemon's status, live tuning, arm and stop, and the demo
+//! (with the `sim` feature). See `handctl --help`; the commands are in [`driver::cli`].
 
 fn main() -> std::process::ExitCode {
-    cli::run()
+    driver::cli::run()
 }

@@ -18,7 +18,7 @@ use driver::rt::{lock_memory, set_fifo, RtReport};
 use driver::service::ControlHandler;
 use driver::socketcan_bus::SocketCanTransport;
 use driver::startup::{engine_settings, load_model};
-use hand_model::{Clock, SystemClock};
+use hand_clock::{Clock, SystemClock};
 
 /// The handstack daemon.
 #[derive(Parser, Debug)]

@@ -40,7 +40,8 @@ pub enum Command {
     /// Record a CAN bus to DIR/frames.log (candump) and, with handsim's trials, a session.
     Record(RecordArgs),
     /// The whole system in one process: calibrate the simulated patient, train ResDD, drive
-    /// the simulated hand while the patient tracks a sine, and score the tracking.
+    /// the simulated hand while the patient tracks a sine, and score the tracking (needs a
+    /// handctl built with the `sim` feature).
     Demo(DemoArgs),
 }
 
@@ -154,7 +155,8 @@ pub struct EvalArgs {
     /// Session to test on; without it the last repetition of every trial kind is held out.
     #[arg(long)]
     pub test: Option<String>,
-    /// Directory for the PNG figures (ROC and interpolation curves per model).
+    /// Directory for the ROC and interpolation curves per model: CSV, and PNG figures in a
+    /// handctl built with the `plots` feature.
     #[arg(long)]
     pub plots: Option<PathBuf>,
     #[command(flatten)]

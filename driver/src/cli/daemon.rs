@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use driver::config::{Config, DEFAULT_CONFIG_PATH};
-use driver::control::request;
-use driver::protocol::{Reply, Request, Status};
-use driver::units::FINGER_NAMES;
+use crate::config::{Config, DEFAULT_CONFIG_PATH};
+use crate::control::{request, ControlError};
+use crate::protocol::{Reply, Request, Status};
+use crate::units::FINGER_NAMES;
 
 use super::args::{DaemonOpts, TuneArgs};
 use super::error::CliError;
@@ -24,13 +24,13 @@ fn socket_of(o: &DaemonOpts) -> Result<PathBuf, CliError> {
         Ok(c) => Ok(c.control.socket),
         // Without an explicit --config, a missing default file just means the default socket.
         Err(_) if o.config.is_none() && !path.exists() => Ok(Config::default().control.socket),
-        Err(e) => Err(CliError::Usage(format!("cannot find handd's socket: {e}"))),
+        Err(e) => Err(CliError::Config(e)),
     }
 }
 
 fn ask(o: &DaemonOpts, req: &Request) -> Result<Reply, CliError> {
     let socket = socket_of(o)?;
-    request(&socket, req).map_err(|e| CliError::Usage(e.to_string()))
+    Ok(request(&socket, req)?)
 }
 
 fn done(reply: Reply) -> Result<Option<Status>, CliError> {
@@ -97,7 +97,7 @@ pub fn format_status(s: &Status) -> String {
 /// `handctl status`.
 pub fn status(o: &DaemonOpts, json: bool) -> Result<(), CliError> {
     let status = done(ask(o, &Request::Status)?)?
-        .ok_or_else(|| CliError::Usage("handd sent no status".into()))?;
+        .ok_or_else(|| ControlError::BadReply("a reply without the status".into()))?;
     if json {
         println!(
             "{}",

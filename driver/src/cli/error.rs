@@ -23,6 +23,38 @@ pub enum CliError {
         /// What the OS said.
         source: std::io::Error,
     },
+    /// handd's control socket could not be reached, or answered badly (the io::Error, if any,
+    /// is the source).
+    #[error(transparent)]
+    Control(#[from] crate::control::ControlError),
+    /// The configuration that names handd's socket could not be read.
+    #[error("cannot find handd's socket: {0}")]
+    Config(#[from] crate::config::ConfigError),
+    /// The CAN interface is down or missing.
+    #[error(transparent)]
+    Bus(#[from] crate::transport::TransportError),
+    /// A CAN socket could not be opened, set up or read.
+    #[error("CAN interface {iface:?}: {what}: {source}")]
+    Can {
+        /// The interface.
+        iface: String,
+        /// What was being done.
+        what: String,
+        /// What the OS said.
+        source: std::io::Error,
+    },
+    /// The command is not in this build of handctl.
+    #[cfg_attr(
+        feature = "sim",
+        allow(dead_code, reason = "only a build without `sim` leaves a command out")
+    )]
+    #[error("{what} is not in this build of handctl; build it with: {build}")]
+    NotBuilt {
+        /// The command or option.
+        what: &'static str,
+        /// The command line that builds it.
+        build: &'static str,
+    },
     /// The quality gates found trials to redo.
     #[error("the session failed its quality gates ({0} trial problem(s) above); redo those trials, or pass --ignore-gates")]
     Gates(usize),
@@ -38,5 +70,27 @@ impl CliError {
             CliError::Gates(_) => 3,
             _ => 1,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::control::ControlError;
+
+    #[test]
+    fn socket_failures_keep_the_os_error_as_their_source() {
+        let e = CliError::from(ControlError::Connect {
+            path: "/run/handstack/handctl.sock".into(),
+            source: std::io::Error::from(std::io::ErrorKind::ConnectionRefused),
+        });
+        assert!(matches!(e, CliError::Control(_)), "{e:?}");
+        let source = std::error::Error::source(&e).expect("a source");
+        let io = source
+            .downcast_ref::<std::io::Error>()
+            .expect("the io::Error itself");
+        assert_eq!(io.kind(), std::io::ErrorKind::ConnectionRefused);
+        assert!(e.to_string().contains("handctl.sock"), "{e}");
+        assert_eq!(e.exit_code(), 1);
     }
 }

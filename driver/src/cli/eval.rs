@@ -1,10 +1,11 @@
 //! `handctl eval`: train every named model on one session, score all on held-out data, print
-//! the paper's tables and write the figures.
+//! the paper's tables and write the curves as CSV, and as PNG figures with the `plots` feature
+//! (the daemon's build links no plotting stack).
 
 use std::path::Path;
 
 use decoder::eval::{
-    direction_table, evaluate_model, interpolation_png, interpolation_table, roc_png,
+    direction_table, evaluate_model, interpolation_csv, interpolation_table, roc_csv, write_csv,
     InterpolationConfig, ModelEvaluation,
 };
 use decoder::session::{LabelledWindows, Session, WindowOptions};
@@ -101,28 +102,43 @@ pub fn run(a: &EvalArgs) -> Result<(), CliError> {
     println!();
     print!("{}", interpolation_table(&evals, icfg.tolerance));
     if let Some(dir) = &a.plots {
-        println!("\nfigures in {}", dir.display());
+        println!("\n{} in {}", FIGURES, dir.display());
     }
     Ok(())
 }
 
+/// What `--plots` writes in this build.
+#[cfg(feature = "plots")]
+const FIGURES: &str = "curves (CSV) and figures (PNG)";
+#[cfg(not(feature = "plots"))]
+const FIGURES: &str = "curves as CSV (PNG figures need handctl built with --features plots)";
+
+/// The curves as CSV always; the PNG figures with the `plots` feature.
 fn write_plots(dir: &Path, e: &ModelEvaluation) -> Result<(), CliError> {
     let name = e.kind.name();
-    let per_finger: Vec<_> = e
+    let roc: Vec<_> = e
         .direction
         .iter()
         .map(|d| d.as_ref().map(|d| (d.roc.as_slice(), d.auc)))
         .collect();
-    roc_png(
-        &dir.join(format!("roc_{name}.png")),
-        &format!("{name}: direction ROC per finger"),
-        &per_finger,
+    write_csv(&dir.join(format!("roc_{name}.csv")), &roc_csv(&roc))?;
+    write_csv(
+        &dir.join(format!("interpolation_{name}.csv")),
+        &interpolation_csv(&e.levels, &e.curves),
     )?;
-    interpolation_png(
-        &dir.join(format!("interpolation_{name}.png")),
-        &format!("{name}: output against effort k (dashed: ideal s·k; red: failed curves)"),
-        &e.levels,
-        &e.curves,
-    )?;
+    #[cfg(feature = "plots")]
+    {
+        decoder::eval::roc_png(
+            &dir.join(format!("roc_{name}.png")),
+            &format!("{name}: direction ROC per finger"),
+            &roc,
+        )?;
+        decoder::eval::interpolation_png(
+            &dir.join(format!("interpolation_{name}.png")),
+            &format!("{name}: output against effort k (dashed: ideal s·k; red: failed curves)"),
+            &e.levels,
+            &e.curves,
+        )?;
+    }
     Ok(())
 }

@@ -1,7 +1,13 @@
-//! The `handctl` commands: one module per subcommand, the argument structures in `args`.
+//! `handctl`, the technician's command line: one module per subcommand, the argument
+//! structures in `args`; `bin/handctl.rs` calls [`run`].
+//!
+//! `handctl demo` always parses; it runs only in a build with the `sim` feature (the
+//! simulator), and otherwise fails saying how to build it. `handctl eval --plots` draws PNG
+//! figures with the `plots` feature, and writes the curves as CSV without it.
 
 mod args;
 mod daemon;
+#[cfg(feature = "sim")]
 mod demo;
 mod error;
 mod eval;
@@ -31,7 +37,7 @@ pub fn run() -> ExitCode {
         Command::Arm(o) => daemon::arm(o),
         Command::Stop(o) => daemon::stop(o),
         Command::Record(a) => record::run(a),
-        Command::Demo(a) => demo::run(a),
+        Command::Demo(a) => run_demo(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -40,4 +46,20 @@ pub fn run() -> ExitCode {
             ExitCode::from(e.exit_code())
         }
     }
+}
+
+/// How to build a handctl with the demo.
+pub const DEMO_BUILD: &str = "cargo run --release --features sim --bin handctl -- demo";
+
+#[cfg(feature = "sim")]
+fn run_demo(a: &args::DemoArgs) -> Result<(), error::CliError> {
+    demo::run(a)
+}
+
+#[cfg(not(feature = "sim"))]
+fn run_demo(_: &args::DemoArgs) -> Result<(), error::CliError> {
+    Err(error::CliError::NotBuilt {
+        what: "the demo (it runs on the simulator, the `sim` feature)",
+        build: DEMO_BUILD,
+    })
 }

@@ -46,7 +46,8 @@ impl Progress {
         }
     }
 
-    /// Ends the live line if an epoch was shown since the last call.
+    /// Ends the live line if an epoch was shown since the last call (the demo's phases).
+    #[cfg(feature = "sim")]
     pub fn finish_if_started(&mut self) {
         if self.started {
             self.finish();

@@ -19,15 +19,16 @@ use std::io::BufWriter;
 use std::path::Path;
 use std::time::{Duration, Instant, UNIX_EPOCH};
 
+use decoder::dsp::ChainConfig;
+use decoder::session::{SessionMeta, Trial, TrialTable};
 use hand_dbc::candump::LogWriter;
+use hand_dbc::emg::EMG_CHANNELS;
 use hand_dbc::CanFrame;
-use hand_model::emg::{ADC_MAX, N_CHANNELS};
-use hand_model::patient::CalibrationTrial;
-use serde::{Deserialize, Serialize};
 use socketcan::{CanSocket, EmbeddedFrame, Socket, SocketOptions};
 
 use super::args::RecordArgs;
 use super::error::CliError;
+use crate::units::ADC_MAX;
 
 /// EMG_SAMPLES_G0's id (hand.dbc): the frame that carries the sample counter first.
 const EMG_G0_ID: u32 = 0x100;
@@ -79,9 +80,7 @@ pub fn run(a: &RecordArgs) -> Result<(), CliError> {
     );
     if let Some(trials) = trials {
         let start_us = scenario_start(&counts)?;
-        let text = session_toml(&trials, start_us, a.mains)?;
-        let meta = a.out.join(decoder::session::META_FILE);
-        std::fs::write(&meta, text).map_err(io_err(&meta))?;
+        session_meta(&trials, start_us, a.mains).write(&a.out)?;
         // The session must open: a recorder that writes what the trainer cannot read is broken.
         let s = decoder::session::Session::open(&a.out)?;
         eprintln!(
@@ -96,8 +95,12 @@ pub fn run(a: &RecordArgs) -> Result<(), CliError> {
 }
 
 fn open(iface: &str) -> Result<CanSocket, CliError> {
-    driver::socketcan_bus::interface_up(iface).map_err(|e| CliError::Usage(e.to_string()))?;
-    let bad = |e: std::io::Error| CliError::Usage(format!("cannot open {iface:?}: {e}"));
+    crate::socketcan_bus::interface_up(iface)?;
+    let bad = |source| CliError::Can {
+        iface: iface.to_owned(),
+        what: "cannot open it".into(),
+        source,
+    };
     let sock = CanSocket::open(iface).map_err(bad)?;
     sock.set_recv_timestamp(true).map_err(bad)?;
     sock.set_error_filter_accept_all().map_err(bad)?;
@@ -123,11 +126,12 @@ fn record(sock: &CanSocket, iface: &str, path: &Path, seconds: f64) -> Result<Co
             {
                 continue
             }
-            Err(e) => {
-                return Err(CliError::Usage(format!(
-                    "reading {iface:?} failed after {} frames: {e}",
-                    counts.frames
-                )))
+            Err(source) => {
+                return Err(CliError::Can {
+                    iface: iface.to_owned(),
+                    what: format!("reading failed after {} frames", counts.frames),
+                    source,
+                })
             }
         };
         let time_us = ts
@@ -170,98 +174,58 @@ fn scenario_start(c: &Counts) -> Result<u64, CliError> {
     }
 }
 
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct TrialsFile {
-    trial: Vec<CalibrationTrial>,
-}
-
-fn read_trials(path: &Path) -> Result<Vec<CalibrationTrial>, CliError> {
+fn read_trials(path: &Path) -> Result<Vec<Trial>, CliError> {
     let text = std::fs::read_to_string(path).map_err(io_err(path))?;
-    let f: TrialsFile = toml::from_str(&text).map_err(|e| {
+    let table = TrialTable::parse(&text).map_err(|e| {
         CliError::Usage(format!(
             "{}: not a trials file as handsim --trials-out writes it: {e}",
             path.display()
         ))
     })?;
-    if f.trial.is_empty() {
+    if table.trial.is_empty() {
         return Err(CliError::Usage(format!(
             "{}: holds no trials (record a calibration scenario)",
             path.display()
         )));
     }
-    Ok(f.trial)
+    Ok(table.trial)
 }
 
-#[derive(Serialize)]
-struct SessionDoc<'a> {
-    format_version: u32,
-    onset_skip_ms: f64,
-    chain: ChainDoc,
-    recording: RecordingDoc,
-    trial: &'a [CalibrationTrial],
-}
-
-#[derive(Serialize)]
-struct ChainDoc {
-    channels: usize,
-    sample_rate_hz: f64,
-    mains_hz: u32,
-}
-
-#[derive(Serialize)]
-struct RecordingDoc {
-    format: &'static str,
-    file: &'static str,
-    full_scale: f64,
-}
-
-fn session_toml(
-    trials: &[CalibrationTrial],
-    start_us: u64,
-    mains_hz: u32,
-) -> Result<String, CliError> {
-    let shifted: Vec<CalibrationTrial> = trials
+/// The session's metadata: the trials shifted onto the log's time base by `start_us`.
+fn session_meta(trials: &[Trial], start_us: u64, mains_hz: u32) -> SessionMeta {
+    let shifted = trials
         .iter()
-        .map(|t| CalibrationTrial {
+        .map(|t| Trial {
             start_us: t.start_us + start_us,
             end_us: t.end_us + start_us,
             ..*t
         })
         .collect();
-    let doc = SessionDoc {
-        format_version: decoder::session::FORMAT_VERSION,
-        onset_skip_ms: 0.0,
-        chain: ChainDoc {
-            channels: N_CHANNELS,
-            sample_rate_hz: 1000.0,
-            mains_hz,
-        },
-        recording: RecordingDoc {
-            format: "candump",
-            file: FRAMES_FILE,
-            full_scale: f64::from(ADC_MAX),
-        },
-        trial: &shifted,
+    let chain = ChainConfig {
+        channels: EMG_CHANNELS,
+        sample_rate_hz: 1000.0,
+        mains_hz,
+        ..ChainConfig::default()
     };
-    toml::to_string(&doc).map_err(|e| CliError::Usage(format!("cannot write session.toml: {e}")))
+    SessionMeta::candump(chain, FRAMES_FILE, f64::from(ADC_MAX), shifted)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use decoder::session::TrialKind;
 
     #[test]
     fn trials_are_shifted_onto_the_log_time_base() {
-        let t = CalibrationTrial {
+        let t = Trial {
             id: 1,
             finger: Some(1),
-            kind: hand_model::patient::TrialKind::Flexion,
+            kind: TrialKind::Flexion,
             start_us: 1_000,
             end_us: 2_000,
             repetition: 1,
         };
-        let text = session_toml(&[t], 1_700_000_000_000_000, 50).expect("serialises");
+        let text = session_meta(&[t], 1_700_000_000_000_000, 50).to_toml();
         let meta = decoder::session::SessionMeta::parse(&text, Path::new("session.toml"))
             .expect("decoder reads what the recorder writes");
         assert_eq!(meta.trials.len(), 1);

@@ -12,7 +12,7 @@ use decoder::model::{
 };
 use driver::daemon::Runner;
 use driver::engine::{Engine, EngineSettings};
-use driver::transport::MemTransport;
+use driver::mem_transport::MemTransport;
 use hand_dbc::messages::{FingerMode, FingerSetpoint};
 use hand_dbc::CanFrame;
 use hand_model::faults::FaultPlan;

@@ -132,8 +132,8 @@ fn run() -> Result<(), String> {
         None => run.duration_us,
     };
     if let Some(path) = &args.trials_out {
-        let text = run.trials_toml().map_err(|e| e.to_string())?;
-        std::fs::write(path, text).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+        std::fs::write(path, run.trials_toml())
+            .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     }
     let mut plan = FaultPlan::new();
     for spec in &args.faults {
@@ -150,13 +150,10 @@ fn run() -> Result<(), String> {
         mains,
         ..AmplifierConfig::default()
     };
-    let session_toml = match &args.session_out {
-        Some(_) => Some(
-            run.session_toml("frames.log", &amp_signal)
-                .map_err(|e| e.to_string())?,
-        ),
-        None => None,
-    };
+    let session_meta = args
+        .session_out
+        .as_ref()
+        .map(|_| run.session_meta("frames.log", &amp_signal));
     let amp = AmplifierNodeConfig {
         signal: amp_signal,
         ..AmplifierNodeConfig::default()
@@ -206,14 +203,12 @@ fn run() -> Result<(), String> {
                 Ok::<_, String>(())
             })
             .map_err(|e| e.to_string())??;
-            if let (Some((mut w, path)), Some(dir), Some(text)) =
-                (log, &args.session_out, &session_toml)
+            if let (Some((mut w, path)), Some(dir), Some(meta)) =
+                (log, &args.session_out, &session_meta)
             {
                 w.flush()
                     .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-                let meta = dir.join("session.toml");
-                std::fs::write(&meta, text)
-                    .map_err(|e| format!("cannot write {}: {e}", meta.display()))?;
+                meta.write(dir).map_err(|e| e.to_string())?;
             }
             let secs = duration_us as f64 * 1e-6;
             println!(

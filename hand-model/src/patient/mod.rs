@@ -6,7 +6,8 @@ pub mod intent;
 pub mod script;
 pub mod tracking;
 
-pub use calibration::{CalibrationPlan, CalibrationProtocol, CalibrationTrial, TrialKind};
+pub use calibration::{CalibrationPlan, CalibrationProtocol};
+pub use decoder::session::{Trial, TrialKind};
 pub use intent::{Intent, MuscleDrive};
 pub use script::{target_intent, Gesture, Motion, Script, Segment};
 pub use tracking::{ClosedLoopUser, Target, TrackingConfig};
