@@ -13,27 +13,10 @@ pub struct RadPerSec(pub f64);
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Default)]
 pub struct RadPerSec2(pub f64);
 
-// single source: hand_dbc::hand (N_FINGERS, FINGER_NAMES, finger_index, ADC_MIN, ADC_MAX are
-// being added to the codec crate; switch these to re-exports of it at the merge).
-
-/// Largest raw EMG value of the amplifier's signed 12-bit ADC, in bus LSB: where the bus's EMG
-/// signals saturate (a recorded session's `full_scale`).
-pub const ADC_MAX: i16 = 2047;
-
-/// Number of fingers of the hand: 0 thumb, 1 index, 2 middle, 3 ring, 4 pinky.
-pub const N_FINGERS: usize = 5;
-
-/// Finger names in index order, as the CLI and the config file spell them.
-pub const FINGER_NAMES: [&str; N_FINGERS] = ["thumb", "index", "middle", "ring", "pinky"];
-
-/// The index of a finger from its name (`"index"`) or its number (`"1"`).
-pub fn finger_index(name: &str) -> Option<usize> {
-    let lower = name.trim().to_ascii_lowercase();
-    FINGER_NAMES
-        .iter()
-        .position(|n| *n == lower)
-        .or_else(|| lower.parse::<usize>().ok().filter(|&i| i < N_FINGERS))
-}
+/// The hand's single-source constants (from hand.dbc's generated code): the number of fingers
+/// and their names (0 thumb .. 4 pinky), and the EMG ADC's upper rail, in bus LSB, where a
+/// recorded session's `full_scale` lies.
+pub use hand_dbc::hand::{finger_index, ADC_MAX, FINGER_NAMES, N_FINGERS};
 
 #[cfg(test)]
 mod tests {

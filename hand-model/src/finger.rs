@@ -9,8 +9,8 @@
 
 use crate::error::{check_range, SimError};
 
-/// Number of fingers: 0 thumb, 1 index, 2 middle, 3 ring, 4 pinky.
-pub const N_FINGERS: usize = 5;
+/// Number of fingers: 0 thumb, 1 index, 2 middle, 3 ring, 4 pinky (from hand.dbc).
+pub use hand_dbc::hand::N_FINGERS;
 
 /// Commanded mode (hand.dbc FINGER_SETPOINT Mode).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

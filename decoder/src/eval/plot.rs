@@ -13,8 +13,9 @@ use super::direction::RocPoint;
 use super::error::EvalError;
 use super::interpolation::InterpolationCurve;
 
-const FINGER_NAMES: [&str; 5] = ["thumb", "index", "middle", "ring", "pinky"];
-const COLOURS: [RGBColor; 5] = [
+use hand_dbc::hand::{FINGER_NAMES, N_FINGERS};
+
+const COLOURS: [RGBColor; N_FINGERS] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),
@@ -119,7 +120,7 @@ pub fn interpolation_png(
         .iter()
         .flat_map(|c| c.outputs.iter())
         .fold((-1.2f64, 1.2f64), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-    let panels = root.split_evenly((1, 5));
+    let panels = root.split_evenly((1, N_FINGERS));
     for (f, panel) in panels.iter().enumerate() {
         let mut chart = ChartBuilder::on(panel)
             .caption(FINGER_NAMES[f], ("sans-serif", 18))

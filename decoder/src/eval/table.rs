@@ -4,7 +4,7 @@ use std::fmt::Write;
 
 use super::evaluate::ModelEvaluation;
 
-const FINGERS: [&str; 5] = ["thumb", "index", "middle", "ring", "pinky"];
+use hand_dbc::hand::FINGER_NAMES as FINGERS;
 
 /// Table 3: per finger and model, direction AUC ± Hanley-McNeil SE and sign accuracy.
 pub fn direction_table(evals: &[ModelEvaluation]) -> String {

@@ -8,8 +8,8 @@ use crate::dsp::{ChainConfig, FEATURES_PER_CHANNEL};
 
 use super::error::TrainError;
 
-/// Number of fingers (outputs): 0 thumb, 1 index, 2 middle, 3 ring, 4 pinky.
-pub const N_FINGERS: usize = 5;
+/// Number of fingers (outputs): 0 thumb, 1 index, 2 middle, 3 ring, 4 pinky (from hand.dbc).
+pub use hand_dbc::hand::N_FINGERS;
 
 /// Training windows produced by one signal chain configuration.
 #[derive(Debug, Clone, PartialEq)]

@@ -273,7 +273,7 @@ pub fn load_label_table(path: &Path, sample_rate_hz: f64) -> Result<Vec<Trial>, 
         let finger = match at(c_f).to_ascii_lowercase().as_str() {
             "all" => None,
             s => match s.parse::<usize>() {
-                Ok(v) if v < 5 => Some(v),
+                Ok(v) if v < FINGER_NAMES.len() => Some(v),
                 _ => Some(FINGER_NAMES.iter().position(|n| *n == s).ok_or_else(|| {
                     bad(format!("finger \"{s}\" is not 0..4, a finger name or all"))
                 })?),

@@ -6,10 +6,8 @@ use std::fmt;
 
 use serde::{Deserialize, Serialize};
 
-/// Number of fingers (0 thumb, 1 index, 2 middle, 3 ring, 4 pinky).
-pub const N_FINGERS: usize = 5;
-/// Finger names by index.
-pub const FINGER_NAMES: [&str; N_FINGERS] = ["thumb", "index", "middle", "ring", "pinky"];
+/// Number of fingers and their names by index (0 thumb .. 4 pinky), from hand.dbc.
+pub use hand_dbc::hand::{FINGER_NAMES, N_FINGERS};
 
 /// What a trial asked for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]

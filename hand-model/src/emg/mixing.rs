@@ -14,7 +14,7 @@
 use crate::finger::N_FINGERS;
 
 /// Number of EMG channels (hand.dbc: EMG_SAMPLES_G0..G2, 4 channels each).
-pub const N_CHANNELS: usize = 12;
+pub use hand_dbc::emg::EMG_CHANNELS as N_CHANNELS;
 /// Number of muscle sources: a flexor and an extensor per finger.
 pub const N_SOURCES: usize = 2 * N_FINGERS;
 

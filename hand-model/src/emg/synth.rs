@@ -14,10 +14,8 @@ use super::mixing::{crosstalk_matrix, N_CHANNELS, N_SOURCES};
 use super::noise::GaussianNoise;
 use crate::error::SimError;
 
-/// Smallest ADC count (signed 12-bit).
-pub const ADC_MIN: i16 = -2048;
-/// Largest ADC count (signed 12-bit).
-pub const ADC_MAX: i16 = 2047;
+/// Smallest and largest ADC count (signed 12-bit), from hand.dbc.
+pub use hand_dbc::hand::{ADC_MAX, ADC_MIN};
 
 /// Activation of the 10 muscle sources, each in 0..=1 (see [`super::mixing::flexor`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
