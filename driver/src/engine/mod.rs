@@ -423,7 +423,7 @@ impl Engine {
         // the last run: the setpoints never wait for the chain's next step.
         if valid && self.samples_in != self.samples_used {
             self.samples_used = self.samples_in;
-            let y = self.predictor.run(self.chain.features_now());
+            let y = self.predictor.run(self.chain.features());
             if y.iter().all(|v| v.is_finite()) {
                 self.labels = y;
             } else {
