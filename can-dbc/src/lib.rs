@@ -11,6 +11,8 @@
 //! - [`CanFrame`]: the concrete classic-CAN frame (implements [`embedded_can::Frame`]).
 //! - [`e2e`]: alive counter + CRC-8 SAE J1850 protection and the receiver-side checker.
 //! - [`emg`]: reassembly of 12-channel sEMG samples from the three EMG frame groups.
+//! - [`emg_front`]: the one EMG front end (E2E, decode, reassembly, rails, µV) that the daemon
+//!   and offline session loading share.
 //! - [`busload`]: worst-case bus load computed from the DBC.
 //! - [`candump`]: can-utils log reading and writing.
 //!
@@ -44,6 +46,7 @@ pub mod busload;
 pub mod candump;
 pub mod e2e;
 pub mod emg;
+pub mod emg_front;
 mod error;
 mod frame;
 pub mod hand;

@@ -192,7 +192,8 @@ fn a_silent_channel_settles_to_exact_zero_not_subnormals() {
     let mut smallest_nonzero = f64::MAX;
     for _ in 0..200_000 {
         chain.push(&[0.0, 0.0]);
-        for &v in chain.last_filtered().iter().chain(chain.features()) {
+        chain.features();
+        for &v in chain.last_filtered().iter().chain(chain.last_features()) {
             if v != 0.0 {
                 smallest_nonzero = smallest_nonzero.min(v.abs());
             }
@@ -256,13 +257,13 @@ fn features_equal_the_formulas_over_the_processed_window() {
 }
 
 #[test]
-fn features_now_match_the_step_features_and_follow_every_sample() {
+fn features_on_request_equal_the_window_end_rows_bit_for_bit_and_follow_every_sample() {
     let ch = 12;
     let s = settings(ch);
     let w = s.window_len();
     let mut chain = Chain::new(&s);
-    // A chain whose step is one sample produces a vector for every window end: what
-    // features_now must give at every sample, not only every step.
+    // A chain whose step is one sample has a window end at every sample: the features asked
+    // for at any sample (as the daemon does at its tick) must be its rows, bit for bit.
     let one = ChainConfig {
         channels: ch,
         step_ms: 1.0,
@@ -271,14 +272,6 @@ fn features_now_match_the_step_features_and_follow_every_sample() {
     .validate()
     .expect("valid configuration");
     let mut every = Chain::new(&one);
-    let close = |a: &[f64], b: &[f64], what: &str| {
-        for (i, (x, y)) in a.iter().zip(b).enumerate() {
-            assert!(
-                (x - y).abs() <= 1e-9 * x.abs().max(1e-12),
-                "{what}: feature {i}: {x} vs {y}"
-            );
-        }
-    };
     let (mut at_steps, mut between) = (0, 0);
     for n in 0..1500 {
         let x = sample(n, ch);
@@ -287,14 +280,15 @@ fn features_now_match_the_step_features_and_follow_every_sample() {
         if chain.samples_seen() < w as u64 {
             continue;
         }
-        let now = chain.features_now().to_vec();
-        close(every.features(), &now, &format!("sample {n}"));
-        if ready {
-            close(
-                chain.features(),
-                &now,
-                &format!("step vector at sample {n}"),
+        let now = chain.features().to_vec();
+        for (i, (a, b)) in every.features().iter().zip(&now).enumerate() {
+            assert_eq!(
+                a.to_bits(),
+                b.to_bits(),
+                "sample {n} feature {i}: {a} vs {b}"
             );
+        }
+        if ready {
             at_steps += 1;
         } else {
             between += 1;
@@ -302,11 +296,13 @@ fn features_now_match_the_step_features_and_follow_every_sample() {
     }
     assert!(at_steps >= 20 && between >= 1000, "{at_steps} {between}");
     // The window slides with every sample.
-    let before = chain.features_now().to_vec();
+    let before = chain.features().to_vec();
     chain.push(&sample(1500, ch));
     assert_ne!(
         before,
-        chain.features_now(),
-        "features_now must follow every sample"
+        chain.features(),
+        "features must follow every sample"
     );
+    let now = chain.features().to_vec();
+    assert_eq!(now, chain.last_features());
 }

@@ -55,8 +55,9 @@ fn check_shape(settings: &ChainSettings, samples: &[f64]) -> Result<(), BatchErr
 }
 
 /// Features of one recording (`samples` row-major, `n x channels`), computed by a fresh
-/// [`Chain`] (reset state) exactly as the streaming path does: row `i` equals the chain's
-/// features after sample `settings.window_end(i)`, bit for bit.
+/// [`Chain`] (reset state) exactly as the streaming path does: row `i` is
+/// [`Chain::features`] after sample `settings.window_end(i)`, bit for bit (the very call the
+/// daemon makes at a tick whose window ends there).
 pub fn try_batch_features(
     settings: &ChainSettings,
     samples: &[f64],

@@ -2,7 +2,7 @@
 
 use super::config::{ChainSettings, FeatureSignal};
 use super::faults::{Faults, MAX_ABS_SAMPLE};
-use super::features::{features_into, Stats, FEATURES_PER_CHANNEL};
+use super::features::{features_into, FEATURES_PER_CHANNEL};
 
 /// Filter state smaller than this is set to exactly 0 (every [`FLUSH_EVERY`] samples). Without
 /// it a silent channel's IIR state decays into subnormal numbers and stays there in a limit
@@ -16,9 +16,11 @@ const FLUSH_EVERY: u64 = 64;
 /// The streaming signal chain for all channels (see the module docs for the stages).
 ///
 /// Built once from [`ChainSettings`] (all memory is allocated then), fed one multi-channel
-/// sample at a time with [`Chain::push`]. Every `step_len` samples, once the first window is
-/// full, a new feature vector is ready in [`Chain::features`]. Nothing here allocates, returns a
-/// `Result` or panics after construction.
+/// sample at a time with [`Chain::push`], which only filters and windows. Features are computed
+/// on request ([`Chain::features`]) over the whole window ending at the newest sample: the one
+/// feature computation, which the offline path requests at every window end (every `step_len`
+/// samples once the first window is full; `push` says when) and the daemon at its ticks.
+/// Nothing here allocates, returns a `Result` or panics after construction.
 ///
 /// Layout: filter state is section-major (`[section][channel]`), so each section runs over all
 /// channels in one loop the compiler vectorises; every channel still sees exactly the
@@ -40,21 +42,12 @@ pub struct Chain {
     head: usize,
     /// Samples pushed since the last reset.
     count: u64,
-    /// Feature vectors produced since the last reset.
+    /// Window ends reached since the last reset.
     emitted: u64,
-    /// Samples still to push before the next feature vector.
+    /// Samples still to push before the next window end.
     until_features: usize,
-    /// When the window is a whole number of steps: statistics of each step-long block of the
-    /// window, `[channel][block]`, a ring starting at `block_head` (the oldest), so each
-    /// feature vector only visits the newest `step_len` samples. Empty otherwise (every
-    /// feature vector then visits the whole window).
-    blocks: Vec<Stats>,
-    blocks_per_window: usize,
-    block_head: usize,
-    until_block: usize,
+    /// The features last computed ([`Chain::features`]).
     features: Vec<f64>,
-    /// Features of the window ending at the newest sample, on request ([`Chain::features_now`]).
-    features_now: Vec<f64>,
     /// The current sample of every channel on its way through the cascade; after it, the
     /// filtered output.
     last_filtered: Vec<f64>,
@@ -67,17 +60,11 @@ impl Chain {
         let n_channels = settings.n_channels();
         let n_state = n_channels * settings.cascade().len();
         let window_len = settings.window_len();
-        let step_len = settings.step_len();
-        let blocks_per_window = if window_len.is_multiple_of(step_len) {
-            window_len / step_len
-        } else {
-            0
-        };
         Chain {
             settings: settings.clone(),
             n_channels,
             window_len,
-            step_len,
+            step_len: settings.step_len(),
             rectify: settings.config().feature_signal == FeatureSignal::Rectified,
             z0: vec![0.0; n_state],
             z1: vec![0.0; n_state],
@@ -86,12 +73,7 @@ impl Chain {
             count: 0,
             emitted: 0,
             until_features: window_len,
-            blocks: vec![Stats::default(); n_channels * blocks_per_window],
-            blocks_per_window,
-            block_head: 0,
-            until_block: step_len,
             features: vec![0.0; settings.n_features()],
-            features_now: vec![0.0; settings.n_features()],
             last_filtered: vec![0.0; n_channels],
             faults: Faults::new(n_channels, window_len),
         }
@@ -107,11 +89,7 @@ impl Chain {
         self.count = 0;
         self.emitted = 0;
         self.until_features = self.window_len;
-        self.blocks.fill(Stats::default());
-        self.block_head = 0;
-        self.until_block = self.step_len;
         self.features.fill(0.0);
-        self.features_now.fill(0.0);
         self.last_filtered.fill(0.0);
         self.faults.clear();
     }
@@ -175,8 +153,10 @@ impl Chain {
         }
     }
 
-    /// Feeds one multi-channel sample (one value per channel, in channel order). Returns true
-    /// when a new feature vector is ready in [`Chain::features`].
+    /// Feeds one multi-channel sample (one value per channel, in channel order): filters it and
+    /// puts it in the window. Returns true when the window ends at a step (every `step_len`
+    /// samples once the first window is full): where the offline path takes its feature rows.
+    /// No features are computed here.
     ///
     /// A NaN, infinite or absurdly large value is counted in [`Chain::faults`], resets that
     /// channel's filter state and is filtered as 0. A slice of the wrong length is counted too;
@@ -193,19 +173,9 @@ impl Chain {
             self.ring[base + head + w] = v;
         }
         self.head = if head + 1 == w { 0 } else { head + 1 };
-
-        if self.blocks_per_window > 0 {
-            self.until_block -= 1;
-            if self.until_block == 0 {
-                self.until_block = self.step_len;
-                self.summarize_newest_block();
-            }
-        }
-
         self.until_features -= 1;
         if self.until_features == 0 {
             self.until_features = self.step_len;
-            self.compute_features();
             self.emitted += 1;
             true
         } else {
@@ -213,63 +183,28 @@ impl Chain {
         }
     }
 
-    /// Statistics of the last `step_len` samples of every channel into the block ring.
-    fn summarize_newest_block(&mut self) {
-        let (w, s, nb) = (self.window_len, self.step_len, self.blocks_per_window);
-        for ch in 0..self.n_channels {
-            let end = ch * 2 * w + self.head + w;
-            self.blocks[ch * nb + self.block_head] = Stats::of(&self.ring[end - s..end]);
-        }
-        self.block_head = if self.block_head + 1 == nb {
-            0
-        } else {
-            self.block_head + 1
-        };
-    }
-
-    fn compute_features(&mut self) {
-        let w = self.window_len;
-        let nb = self.blocks_per_window;
-        for ch in 0..self.n_channels {
-            let out =
-                &mut self.features[ch * FEATURES_PER_CHANNEL..(ch + 1) * FEATURES_PER_CHANNEL];
-            if nb > 0 {
-                let blocks = &self.blocks[ch * nb..(ch + 1) * nb];
-                let (newer, older) = blocks.split_at(self.block_head);
-                older
-                    .iter()
-                    .chain(newer)
-                    .fold(Stats::default(), |acc, b| acc.then(b))
-                    .features_into(out);
-            } else {
-                let start = ch * 2 * w + self.head;
-                features_into(&self.ring[start..start + w], out);
-            }
-        }
-    }
-
-    /// The latest feature vector, channel-major, 8 per channel in [`super::FEATURE_NAMES`]
-    /// order. All zeros until the first window is full.
-    pub fn features(&self) -> &[f64] {
-        &self.features
-    }
-
     /// The features of the window that ends at the newest sample, computed now over the whole
-    /// window, whatever the step: for a consumer that reads features at its own times (the
-    /// daemon reads them at each tick, so its setpoints use the newest sample, not one up to
-    /// a step old). Same layout as [`Chain::features`], and equal to it (to rounding) right
-    /// after a vector was produced. Meaningful once [`Chain::samples_seen`] reaches the window
-    /// length (the older part of the window is zeros before). No allocation.
-    pub fn features_now(&mut self) -> &[f64] {
+    /// window: channel-major, 8 per channel in [`super::FEATURE_NAMES`] order. The one feature
+    /// computation of the crate: the offline path ([`super::batch_features`]) calls it at every
+    /// window end, the daemon at each tick, so both get the same bits for the same samples.
+    /// Meaningful once [`Chain::samples_seen`] reaches the window length (the older part of the
+    /// window is zeros before). No allocation.
+    pub fn features(&mut self) -> &[f64] {
         let w = self.window_len;
         for ch in 0..self.n_channels {
             let start = ch * 2 * w + self.head;
             features_into(
                 &self.ring[start..start + w],
-                &mut self.features_now[ch * FEATURES_PER_CHANNEL..(ch + 1) * FEATURES_PER_CHANNEL],
+                &mut self.features[ch * FEATURES_PER_CHANNEL..(ch + 1) * FEATURES_PER_CHANNEL],
             );
         }
-        &self.features_now
+        &self.features
+    }
+
+    /// The features the last [`Chain::features`] call computed (zeros before the first), without
+    /// computing anything.
+    pub fn last_features(&self) -> &[f64] {
+        &self.features
     }
 
     /// Filtered value (after the notch, before rectification) of each channel for the last
@@ -288,7 +223,7 @@ impl Chain {
         self.count
     }
 
-    /// Feature vectors produced since the last reset.
+    /// Window ends ([`Chain::push`] returned true) since the last reset.
     pub fn vectors_emitted(&self) -> u64 {
         self.emitted
     }

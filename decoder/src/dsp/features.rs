@@ -24,29 +24,24 @@ fn lane_sum(acc: [f64; LANES]) -> f64 {
     acc[0] + acc[1]
 }
 
-/// Sufficient statistics of a run of consecutive samples: enough to get the 8 features of the
-/// run, and to merge runs (blocks of a window) without revisiting their samples.
+/// Sums over one window: enough to get its 8 features.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(crate) struct Stats {
+struct Stats {
     n: f64,
-    sum: f64,
     sum_abs: f64,
     sum_sq: f64,
-    /// Sum of |x[i+1] - x[i]| and of (x[i+1] - x[i])^2 inside the run.
+    /// Sum of |x[i+1] - x[i]| and of (x[i+1] - x[i])^2.
     wl: f64,
     d_sq: f64,
-    mean: f64,
-    /// Sum of squared deviations from `mean` (two-pass inside a run, Chan et al. across runs).
+    /// Sum of squared deviations from the mean (two-pass).
     m2: f64,
-    first: f64,
-    last: f64,
 }
 
 impl Stats {
-    /// Statistics of the run `x` (not empty). Allocation-free.
-    pub(crate) fn of(x: &[f64]) -> Stats {
+    /// Statistics of the window `x` (at least 2 samples). Allocation-free.
+    fn of(x: &[f64]) -> Stats {
         let n = x.len();
-        debug_assert!(n > 0);
+        debug_assert!(n > 1);
         // One pass over the pairs (x[i], x[i+1]), i < n - 1: the sums of x[i] and of the
         // differences together; x[n-1] is added at the end.
         let (mut sum, mut sum_abs, mut sum_sq) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
@@ -76,68 +71,20 @@ impl Stats {
         }
         let last = x[n - 1];
         let nf = n as f64;
-        let sum = lane_sum(sum) + last;
-
-        // Two-pass squared deviations: the rectified signal has a large mean next to its
-        // spread, and the one-pass form would cancel catastrophically.
-        let mean = sum / nf;
-        let mut ss = [0.0; LANES];
-        let chunks = x.chunks_exact(LANES);
-        let rest = chunks.remainder();
-        for c in chunks {
-            for l in 0..LANES {
-                let d = c[l] - mean;
-                ss[l] += d * d;
-            }
-        }
-        for (l, &v) in rest.iter().enumerate() {
-            let d = v - mean;
-            ss[l] += d * d;
-        }
-
+        let mean = (lane_sum(sum) + last) / nf;
         Stats {
             n: nf,
-            sum,
             sum_abs: lane_sum(sum_abs) + last.abs(),
             sum_sq: lane_sum(sum_sq) + last * last,
             wl: lane_sum(wl),
             d_sq: lane_sum(d_sq),
-            mean,
-            m2: lane_sum(ss),
-            first: x[0],
-            last,
+            m2: squared_deviations(x, mean),
         }
     }
 
-    /// Statistics of the run `self` immediately followed by the run `next`.
-    pub(crate) fn then(&self, next: &Stats) -> Stats {
-        if self.n == 0.0 {
-            return *next;
-        }
-        let n = self.n + next.n;
-        let jump = next.first - self.last;
-        let delta = next.mean - self.mean;
-        Stats {
-            n,
-            sum: self.sum + next.sum,
-            sum_abs: self.sum_abs + next.sum_abs,
-            sum_sq: self.sum_sq + next.sum_sq,
-            wl: self.wl + next.wl + jump.abs(),
-            d_sq: self.d_sq + next.d_sq + jump * jump,
-            mean: self.mean + delta * (next.n / n),
-            m2: self.m2 + next.m2 + delta * delta * (self.n * next.n / n),
-            first: self.first,
-            last: next.last,
-        }
-    }
-
-    /// The 8 features into `out[..8]` (all 0 for fewer than 2 samples).
-    pub(crate) fn features_into(&self, out: &mut [f64]) {
+    /// The 8 features into `out[..8]`.
+    fn features_into(&self, out: &mut [f64]) {
         let nf = self.n;
-        if nf < 2.0 {
-            out[..FEATURES_PER_CHANNEL].fill(0.0);
-            return;
-        }
         let var = self.m2 / (nf - 1.0);
         out[0] = (self.sum_sq / nf).sqrt();
         out[1] = self.sum_abs / nf;
@@ -148,6 +95,25 @@ impl Stats {
         out[6] = (self.d_sq / (nf - 1.0)).sqrt();
         out[7] = self.wl / (nf - 1.0);
     }
+}
+
+/// Sum of `(x[i] - mean)^2`, the second pass: the rectified signal has a large mean next to
+/// its spread, and the one-pass form would cancel catastrophically.
+fn squared_deviations(x: &[f64], mean: f64) -> f64 {
+    let mut ss = [0.0; LANES];
+    let chunks = x.chunks_exact(LANES);
+    let rest = chunks.remainder();
+    for c in chunks {
+        for l in 0..LANES {
+            let d = c[l] - mean;
+            ss[l] += d * d;
+        }
+    }
+    for (l, &v) in rest.iter().enumerate() {
+        let d = v - mean;
+        ss[l] += d * d;
+    }
+    lane_sum(ss)
 }
 
 /// Features of the window `x` into `out[..8]`. Allocation-free.
@@ -207,27 +173,5 @@ mod tests {
             }
         }
         assert_eq!(window_features(&[3.0]), [0.0; 8]);
-    }
-
-    #[test]
-    fn merged_blocks_equal_the_whole_window() {
-        let x: Vec<f64> = (0..200)
-            .map(|i| ((i * 7919 % 211) as f64 - 105.0).abs() + 3.0 * (i as f64 * 0.1).sin())
-            .collect();
-        let whole = window_features(&x);
-        for block in [1, 7, 50, 100, 199] {
-            let merged = x
-                .chunks(block)
-                .map(Stats::of)
-                .fold(Stats::default(), |acc, b| acc.then(&b));
-            let mut f = [0.0; 8];
-            merged.features_into(&mut f);
-            for (a, b) in f.iter().zip(whole) {
-                assert!(
-                    (a - b).abs() <= 1e-12 * b.abs(),
-                    "block {block}: {a} vs {b}"
-                );
-            }
-        }
     }
 }

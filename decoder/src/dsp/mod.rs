@@ -22,9 +22,10 @@
 //! deliberate difference: every 64 samples, filter state below [`FLUSH_BELOW`] (1e-150) is set
 //! to 0, so a silent channel never sinks into slow subnormal arithmetic.
 //!
-//! The last `window_len` processed values of each channel are kept in a ring buffer; every
-//! `step_len` samples (once the first window is full) the 8 features of the paper's Table 1 are
-//! computed per channel over the window `x[0..N]`, in the order of [`FEATURE_NAMES`]:
+//! The last `window_len` processed values of each channel are kept in a ring buffer, contiguous
+//! in memory. [`Chain::push`] only filters and windows; the 8 features of the paper's Table 1
+//! are computed on request ([`Chain::features`]) per channel over the whole window `x[0..N]`
+//! ending at the newest sample, in the order of [`FEATURE_NAMES`]:
 //!
 //! | name  | formula |
 //! |-------|---------|
@@ -40,11 +41,11 @@
 //! The feature vector is channel-major: `[ch0 RMS, ch0 MAV, .., ch0 DAMV, ch1 RMS, ..]`, 8 values
 //! per channel (96 for 12 channels).
 //!
-//! When the window is a whole number of steps (the default 200/50), each step's samples are
-//! summarised once (sums, in-block differences, mean and squared deviations, two-pass) and the
-//! window's features come from merging the last `window/step` summaries (VAR with Chan et al.'s
-//! pairwise formula), so a tick reads 50 samples per channel, not 200. Otherwise the whole
-//! window is revisited. Both equal the formulas above to rounding (checked against numpy).
+//! There is one feature computation: the offline path ([`batch_features`]) asks for the
+//! features at every window end (every `step_len` samples once the first window is full), the
+//! daemon at each of its ticks, and both run the same function over the same contiguous window,
+//! so the same samples give the same features bit for bit. It equals the formulas above to
+//! rounding (checked against numpy).
 //!
 //! Use: validate a [`ChainConfig`] once into [`ChainSettings`] (the only fallible step), build a
 //! [`Chain`] from it, then [`Chain::push`] one multi-channel sample at a time; nothing after

@@ -11,6 +11,7 @@ mod candump;
 mod error;
 mod gates;
 mod import;
+mod load;
 mod meta;
 mod npy;
 mod recording;

@@ -1,10 +1,5 @@
 //! The raw multi-channel signal of a session, from a candump log or a sample file.
 
-use std::path::Path;
-
-use super::error::SessionError;
-use super::meta::{RecordingFormat, SessionMeta};
-
 /// Raw samples with their times.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Recording {
@@ -19,7 +14,8 @@ pub struct Recording {
     /// Sample indices that follow a gap too long to bridge (over 20 ms): no window may span
     /// one, as the daemon would have marked it invalid.
     pub breaks: Vec<usize>,
-    /// Frames dropped for a wrong CRC (0 for sample files).
+    /// Frames dropped by the E2E check (wrong CRC or length) or refused by the codec (0 for
+    /// sample files).
     pub bad_frames: u64,
     /// Sample units per stored raw unit: µV per LSB for a candump log, 1 for sample files
     /// (what `full_scale` is multiplied by).
@@ -82,32 +78,4 @@ impl Recording {
     pub fn slice(&self, range: std::ops::Range<usize>) -> &[f64] {
         &self.samples[range.start * self.channels..range.end * self.channels]
     }
-
-    /// Reads the recording a session's metadata points to.
-    pub fn load(meta: &SessionMeta, dir: &Path) -> Result<Self, SessionError> {
-        let path = meta.recording_path(dir);
-        match meta.recording.format {
-            RecordingFormat::Npy => load_npy(meta, &path),
-            RecordingFormat::Candump => super::candump::load_candump(meta, &path),
-        }
-    }
-}
-
-fn load_npy(meta: &SessionMeta, path: &Path) -> Result<Recording, SessionError> {
-    let arr = crate::dsp::npy::read_npy(path).map_err(|e| match e {
-        crate::dsp::npy::NpyError::Io { source, .. } => SessionError::io(path, source),
-        other => SessionError::recording(path, other.to_string()),
-    })?;
-    let channels = meta.chain.channels;
-    if arr.shape.len() != 2 || arr.shape[1] != channels {
-        return Err(SessionError::recording(
-            path,
-            format!(
-                "shape {:?} is not (n_samples, {channels}) as [chain] channels says",
-                arr.shape
-            ),
-        ));
-    }
-    Recording::from_samples(channels, arr.data, meta.chain.sample_rate_hz)
-        .map_err(|m| SessionError::recording(path, m))
 }

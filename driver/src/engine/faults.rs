@@ -1,0 +1,49 @@
+//! The deciding side's first half: which faults hold at this tick, and whether the window may
+//! drive the fingers.
+
+use super::Engine;
+use crate::safety::{DaemonState, Fault};
+use crate::units::N_FINGERS;
+
+/// Railed channel values per tick (all channels) that make the signal unusable: a clipped
+/// channel puts one per sample, so 50 ms of one clipped channel gives about 50.
+const RAIL_LIMIT: u64 = 5;
+
+impl Engine {
+    /// Raises the faults of the tick at `now_us` (EMG silence, signal quality, non-finite
+    /// samples, an invalid window) and returns whether the window is valid.
+    pub(super) fn evaluate_faults(&mut self, now_us: u64) -> bool {
+        if now_us.saturating_sub(self.emg.last_emg_us) > self.settings.emg_silence_us {
+            self.raise(now_us, Fault::EmgSilence);
+        }
+        if self.emg.take_railed() >= RAIL_LIMIT || self.inputs.amp_reports_bad {
+            self.raise(now_us, Fault::SignalQuality);
+        }
+        let valid = self
+            .emg
+            .window_valid(now_us, self.settings.tick_us, self.settings.max_gap_us);
+        if self.emg.chain.faults().any_in_window() {
+            self.raise(now_us, Fault::NonFinite);
+        } else if !valid
+            && matches!(
+                self.safety.state(),
+                DaemonState::Running | DaemonState::Safe
+            )
+        {
+            // Raised in SAFE too: the recovery time counts from the first valid window.
+            self.raise(now_us, Fault::InvalidWindow);
+        }
+        valid
+    }
+
+    /// The finger watchdog at `now_us`; its events are kept for [`Engine::drain_events`].
+    pub(super) fn update_watch(&mut self, now_us: u64) {
+        let mut events = [None; N_FINGERS];
+        let mut k = 0;
+        self.watch.update(now_us, |e| {
+            events[k] = Some(e);
+            k += 1;
+        });
+        self.finger_events = events;
+    }
+}

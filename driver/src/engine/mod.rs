@@ -1,0 +1,335 @@
+//! The control loop's core, free of I/O: frames in, frames out, one [`Engine::tick`] every
+//! 50 ms.
+//!
+//! Frames go in with their receive time ([`Engine::on_frame`], `rx`): EMG sample frames pass
+//! the shared front end (`hand_dbc::emg_front`: E2E, decode, reassembly by counter, rails,
+//! µV) and are pushed sample by sample through the signal chain; finger status frames feed the
+//! per-finger watchdog; an E-stop latches SAFE. Each tick evaluates the faults (`faults`), runs
+//! the model on the window ending at the newest sample, conditions the labels and builds one
+//! FINGER_SETPOINT per finger, plus HAND_DIAG every tick and HAND_HEARTBEAT every other tick
+//! (`tx`).
+//!
+//! After construction nothing here allocates (a test counts), returns a `Result` on the tick
+//! path or panics on any frame: every out-of-range value was excluded by validating the
+//! config, so encoding a setpoint cannot fail, and if it ever did the finger gets a safe stop.
+
+mod faults;
+mod rx;
+mod tx;
+
+use decoder::dsp::ChainSettings;
+use decoder::model::Predictor;
+use hand_dbc::CanFrame;
+
+use crate::conditioner::{FingerConditioner, FingerGains, Setpoint};
+use crate::safety::{
+    DaemonState, Fault, FaultSet, FingerEvent, FingerWatch, Safety, SafetyTiming, Transition,
+};
+use crate::stats::Histogram;
+use crate::units::N_FINGERS;
+
+/// Most frames one tick sends: five setpoints, HAND_DIAG and HAND_HEARTBEAT.
+pub const MAX_TX_PER_TICK: usize = N_FINGERS + 2;
+
+/// Timing and gains of the engine, taken from the validated config.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EngineSettings {
+    /// Tick period, µs.
+    pub tick_us: u64,
+    /// No EMG sample frame for this long is a fault, µs.
+    pub emg_silence_us: u64,
+    /// A finger controller silent for this long is disabled, µs.
+    pub finger_silence_us: u64,
+    /// Recovery time of transient faults, µs.
+    pub recovery_us: u64,
+    /// A gap in the samples longer than this makes the window invalid, µs.
+    pub max_gap_us: u64,
+    /// A tick starting later than its deadline plus this is a deadline miss, µs.
+    pub deadline_slack_us: u64,
+    /// Per-finger gains.
+    pub gains: [FingerGains; N_FINGERS],
+    /// Model identity for HAND_HEARTBEAT.
+    pub model_id: u32,
+}
+
+impl Default for EngineSettings {
+    fn default() -> Self {
+        Self {
+            tick_us: 50_000,
+            emg_silence_us: 100_000,
+            finger_silence_us: 100_000,
+            recovery_us: 500_000,
+            max_gap_us: 20_000,
+            deadline_slack_us: 5_000,
+            gains: [FingerGains::default(); N_FINGERS],
+            model_id: 0,
+        }
+    }
+}
+
+/// Counters since start, for HAND_DIAG and `handctl status`.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Counters {
+    /// Ticks run.
+    pub ticks: u64,
+    /// Ticks that started later than their deadline plus the configured slack.
+    pub deadline_misses: u64,
+    /// EMG samples lost and bridged.
+    pub samples_lost: u64,
+    /// Frames with an unknown id, a wrong length or values out of range.
+    pub bad_frames: u64,
+    /// Frames that failed their E2E check (CRC or counter).
+    pub e2e_errors: u64,
+    /// E-stop frames received.
+    pub estops: u64,
+}
+
+/// Requests from technicians, applied at the next tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Command {
+    /// New gains for one finger.
+    SetGains(usize, FingerGains),
+    /// Clear latched faults.
+    Arm,
+    /// Go to SAFE until armed.
+    Stop,
+}
+
+/// Timing of the ticks, for HAND_DIAG and `handctl status`.
+#[derive(Clone, Default)]
+struct TickTiming {
+    latency: Histogram,
+    compute: Histogram,
+    lateness: Histogram,
+    last_latency_us: u64,
+    /// The newest sample counter of the last tick written, for HAND_DIAG.
+    last_newest_counter: u8,
+}
+
+/// The engine. See the module docs. Cloning it forks the whole state (a replay tries
+/// alternatives on clones).
+#[derive(Clone)]
+pub struct Engine {
+    settings: EngineSettings,
+    emg: rx::EmgIn,
+    inputs: rx::Inputs,
+    predictor: Predictor,
+    /// Samples in when the model last ran.
+    samples_used: u64,
+    safety: Safety,
+    watch: FingerWatch<N_FINGERS>,
+    conditioners: [FingerConditioner; N_FINGERS],
+    labels: [f64; N_FINGERS],
+    setpoints: [Setpoint; N_FINGERS],
+    counters: Counters,
+    timing: TickTiming,
+    tx: tx::Tx,
+    transitions: [Option<Transition>; 8],
+    finger_events: [Option<FingerEvent>; N_FINGERS],
+}
+
+impl Engine {
+    /// An engine in BOOT for the chain `settings` and a model's `predictor`, at time `now_us`.
+    /// Panics if the predictor does not take the chain's feature count: the daemon checks the
+    /// model against the chain before it gets here.
+    pub fn new(
+        chain: &ChainSettings,
+        predictor: Predictor,
+        settings: EngineSettings,
+        now_us: u64,
+    ) -> Self {
+        assert_eq!(
+            predictor.n_inputs(),
+            chain.n_features(),
+            "model inputs must equal the chain's features"
+        );
+        assert!(
+            chain.n_channels() <= hand_dbc::emg::EMG_CHANNELS,
+            "the bus carries {} EMG channels",
+            hand_dbc::emg::EMG_CHANNELS
+        );
+        Self {
+            emg: rx::EmgIn::new(chain, settings.max_gap_us, now_us),
+            inputs: rx::Inputs::new(),
+            predictor,
+            samples_used: 0,
+            safety: Safety::new(SafetyTiming {
+                recovery_us: settings.recovery_us,
+                ..SafetyTiming::default()
+            }),
+            watch: FingerWatch::new(now_us, settings.finger_silence_us, settings.recovery_us),
+            conditioners: [FingerConditioner::default(); N_FINGERS],
+            labels: [0.0; N_FINGERS],
+            setpoints: [Setpoint::default(); N_FINGERS],
+            counters: Counters::default(),
+            timing: TickTiming::default(),
+            tx: tx::Tx::new(),
+            transitions: [None; 8],
+            finger_events: [None; N_FINGERS],
+            settings,
+        }
+    }
+
+    fn note(&mut self, t: Option<Transition>) {
+        if let Some(t) = t {
+            if let Some(slot) = self.transitions.iter_mut().find(|s| s.is_none()) {
+                *slot = Some(t);
+            }
+        }
+    }
+
+    /// Config, model and bus are validated: BOOT -> READY.
+    pub fn validated(&mut self, now_us: u64) {
+        let t = self.safety.validated(now_us);
+        self.note(t);
+    }
+
+    /// Report a fault found outside the engine (bus-off, interface down).
+    pub fn raise(&mut self, now_us: u64, fault: Fault) {
+        let t = self.safety.raise(now_us, fault);
+        self.note(t);
+    }
+
+    /// Apply a technician's command (at the next tick's start, by the caller's ordering).
+    pub fn command(&mut self, now_us: u64, cmd: Command) -> Result<(), crate::safety::ArmError> {
+        match cmd {
+            Command::SetGains(f, g) if f < N_FINGERS => self.settings.gains[f] = g,
+            Command::SetGains(..) => {}
+            Command::Arm => self.safety.arm(now_us)?,
+            Command::Stop => self.raise(now_us, Fault::StopRequested),
+        }
+        Ok(())
+    }
+
+    /// The tick due at `now_us` (its deadline), which actually started at `started_us`.
+    /// Everything the tick decides is at its deadline, from the frames received by then (the
+    /// loop holds later ones back for the next tick): so a late wake-up changes when the
+    /// setpoints leave, never what they are, and a recording of the bus replays exactly.
+    /// `started_us` only counts the lateness. Returns the frames to send, in order. No
+    /// allocation.
+    pub fn tick(&mut self, now_us: u64, started_us: u64) -> &[CanFrame] {
+        self.count_tick(now_us, started_us);
+        let valid = self.evaluate_faults(now_us);
+        self.run_model(now_us, valid);
+        let t = self.safety.update(now_us, valid);
+        self.note(t);
+        self.update_watch(now_us);
+        self.transmit()
+    }
+
+    fn count_tick(&mut self, now_us: u64, started_us: u64) {
+        self.counters.ticks += 1;
+        let late = started_us.saturating_sub(now_us);
+        self.timing.lateness.record(late);
+        if late > self.settings.deadline_slack_us {
+            self.counters.deadline_misses += 1;
+        }
+    }
+
+    /// The model, on the window ending at the newest sample, when samples came in since its
+    /// last run: the setpoints never wait for the chain's next step.
+    fn run_model(&mut self, now_us: u64, valid: bool) {
+        if !valid || self.emg.samples_in == self.samples_used {
+            return;
+        }
+        self.samples_used = self.emg.samples_in;
+        let y = self.predictor.run(self.emg.chain.features());
+        if y.iter().all(|v| v.is_finite()) {
+            self.labels = y;
+        } else {
+            self.labels = [0.0; N_FINGERS];
+            self.raise(now_us, Fault::NonFinite);
+        }
+    }
+
+    /// The tick's frames were written at `written_us`, after `compute_us` of work: record the
+    /// latency from the newest sample frame used.
+    pub fn written(&mut self, written_us: u64, compute_us: u64) {
+        self.timing.compute.record(compute_us);
+        // From the newest sample the tick had (the one its window ends at when the model ran),
+        // whether or not the model ran: HAND_DIAG then says which samples each tick had.
+        self.timing.last_newest_counter = self.emg.newest_counter;
+        if let Some(rx) = self.emg.newest_rx_us {
+            let lat = written_us.saturating_sub(rx);
+            self.timing.latency.record(lat);
+            self.timing.last_latency_us = lat;
+        }
+    }
+
+    /// Drains the state transitions and finger events of the last calls, for the log.
+    pub fn drain_events(
+        &mut self,
+        mut on_transition: impl FnMut(Transition),
+        mut on_finger: impl FnMut(FingerEvent),
+    ) {
+        for t in self.transitions.iter_mut().filter_map(Option::take) {
+            on_transition(t);
+        }
+        for e in self.finger_events.iter_mut().filter_map(Option::take) {
+            on_finger(e);
+        }
+    }
+
+    /// The daemon's state.
+    pub fn state(&self) -> DaemonState {
+        self.safety.state()
+    }
+    /// Faults in force.
+    pub fn faults(&self) -> FaultSet {
+        self.safety.faults()
+    }
+    /// Counters since start.
+    pub fn counters(&self) -> Counters {
+        self.counters
+    }
+    /// Latency histogram (newest sample frame -> setpoints written).
+    pub fn latency(&self) -> &Histogram {
+        &self.timing.latency
+    }
+    /// Compute-time histogram.
+    pub fn compute(&self) -> &Histogram {
+        &self.timing.compute
+    }
+    /// How late each tick started after its deadline.
+    pub fn lateness(&self) -> &Histogram {
+        &self.timing.lateness
+    }
+    /// Whether a tick that starts at `now_us` for `deadline_us` is on time.
+    pub fn on_time(&self, now_us: u64, deadline_us: u64) -> bool {
+        now_us <= deadline_us + self.settings.deadline_slack_us
+    }
+    /// Last setpoints per finger.
+    pub fn setpoints(&self) -> &[Setpoint; N_FINGERS] {
+        &self.setpoints
+    }
+    /// Last raw labels from the model.
+    pub fn labels(&self) -> &[f64; N_FINGERS] {
+        &self.labels
+    }
+    /// Force each finger controller last reported, N.
+    pub fn reported_force(&self) -> &[f64; N_FINGERS] {
+        &self.inputs.reported_force
+    }
+    /// Whether finger `f` is disabled.
+    pub fn finger_disabled(&self, f: usize) -> bool {
+        self.watch.is_disabled(f)
+    }
+    /// EMG samples pushed into the chain since start.
+    pub fn samples_in(&self) -> u64 {
+        self.emg.samples_in
+    }
+    /// Samples in ([`Engine::samples_in`]) when the model last ran: its window ended at that
+    /// sample.
+    pub fn samples_used(&self) -> u64 {
+        self.samples_used
+    }
+    /// The features the model last ran on (zeros before its first run); what training's path
+    /// computes for a window ending at [`Engine::samples_used`]. No computation.
+    pub fn model_features(&self) -> &[f64] {
+        self.emg.chain.last_features()
+    }
+    /// Gains in force.
+    pub fn gains(&self) -> &[FingerGains; N_FINGERS] {
+        &self.settings.gains
+    }
+}

@@ -1,0 +1,152 @@
+//! The transmit side: the frames one tick (or a safe stop) sends, built into a fixed buffer.
+
+use hand_dbc::e2e::E2eProtector;
+use hand_dbc::messages::{
+    DaemonState as BusState, FingerMode, FingerSetpoint, HandDiag, HandHeartbeat,
+};
+use hand_dbc::CanFrame;
+
+use super::{Engine, MAX_TX_PER_TICK};
+use crate::conditioner::Setpoint;
+use crate::safety::DaemonState;
+use crate::units::N_FINGERS;
+
+/// The outgoing frames and the E2E state of the protected ones.
+#[derive(Clone)]
+pub(super) struct Tx {
+    setpoint: [E2eProtector; N_FINGERS],
+    heartbeat: E2eProtector,
+    frames: [CanFrame; MAX_TX_PER_TICK],
+    len: usize,
+}
+
+impl Tx {
+    pub(super) fn new() -> Self {
+        Self {
+            setpoint: FingerSetpoint::E2E.map(E2eProtector::new),
+            heartbeat: E2eProtector::new(HandHeartbeat::E2E),
+            frames: [CanFrame::new_standard(0, &[]).expect("an empty frame is valid");
+                MAX_TX_PER_TICK],
+            len: 0,
+        }
+    }
+
+    fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    fn push(&mut self, frame: Option<CanFrame>) {
+        if let Some(frame) = frame {
+            self.frames[self.len] = frame;
+            self.len += 1;
+        }
+    }
+
+    /// The frames built since the last clear.
+    pub(super) fn frames(&self) -> &[CanFrame] {
+        &self.frames[..self.len]
+    }
+
+    /// The one setpoint-frame builder: finger `f`'s setpoint in `mode`, E2E-protected; a
+    /// setpoint the codec refuses becomes a safe stop (never happens with a validated config).
+    fn setpoint(&mut self, f: usize, mode: FingerMode, sp: &Setpoint) {
+        let frame = FingerSetpoint::new(f, mode, sp.force.0, sp.velocity.0)
+            .or_else(|_| FingerSetpoint::new(f, FingerMode::SafeStop, 0.0, 0.0))
+            .ok()
+            .and_then(|m| self.setpoint[f].protect_message(&m).ok());
+        self.push(frame);
+    }
+}
+
+impl Engine {
+    /// The mode of finger `f` when the outputs are off: DISABLED if its controller is silent.
+    fn stopped_mode(&self, f: usize) -> FingerMode {
+        if self.watch.is_disabled(f) {
+            FingerMode::Disabled
+        } else {
+            FingerMode::SafeStop
+        }
+    }
+
+    /// Conditions the labels into setpoints (or stops the fingers) and builds their frames.
+    pub(super) fn build_setpoints(&mut self, running: bool) {
+        let dt_s = self.settings.tick_us as f64 * 1e-6;
+        for f in 0..N_FINGERS {
+            let mode = if running && !self.watch.is_disabled(f) {
+                let gains = &self.settings.gains[f];
+                self.setpoints[f] = self.conditioners[f].step(self.labels[f], gains, dt_s);
+                FingerMode::Active
+            } else {
+                self.conditioners[f].reset();
+                self.setpoints[f] = Setpoint::default();
+                self.stopped_mode(f)
+            };
+            self.tx.setpoint(f, mode, &self.setpoints[f]);
+        }
+    }
+
+    /// HAND_DIAG: latency, counters, the shown labels and the newest sample's counter.
+    pub(super) fn build_diag(&mut self, running: bool) {
+        let l = |x: f64| {
+            (x.clamp(-1.0, 1.0) / HandDiag::LABEL0_FACTOR).round() * HandDiag::LABEL0_FACTOR
+        };
+        let shown = |f: usize| {
+            if running {
+                l(self.setpoints[f].label)
+            } else {
+                0.0
+            }
+        };
+        let diag = HandDiag::new(
+            self.timing.last_latency_us.min(u64::from(u16::MAX)) as u16,
+            self.counters.deadline_misses.min(255) as u8,
+            self.counters.samples_lost.min(255) as u8,
+            shown(0),
+            shown(1),
+            shown(2),
+            shown(3),
+            shown(4),
+            self.timing.last_newest_counter % 4,
+        );
+        self.tx.push(diag.ok().map(|d| d.to_frame()));
+    }
+
+    /// HAND_HEARTBEAT, every other tick: state, faults and model id.
+    pub(super) fn build_heartbeat(&mut self) {
+        if self.counters.ticks.is_multiple_of(2) {
+            return;
+        }
+        let state = match self.safety.state() {
+            DaemonState::Boot => BusState::Boot,
+            DaemonState::Ready => BusState::Ready,
+            DaemonState::Running => BusState::Running,
+            DaemonState::Safe => BusState::Safe,
+        };
+        let frame = HandHeartbeat::new(state, self.safety.faults().0, self.settings.model_id)
+            .ok()
+            .and_then(|m| self.tx.heartbeat.protect_message(&m).ok());
+        self.tx.push(frame);
+    }
+
+    /// The tick's frames, built anew: setpoints, HAND_DIAG, HAND_HEARTBEAT.
+    pub(super) fn transmit(&mut self) -> &[CanFrame] {
+        self.tx.clear();
+        let running = self.safety.outputs_enabled();
+        self.build_setpoints(running);
+        self.build_diag(running);
+        self.build_heartbeat();
+        self.tx.frames()
+    }
+
+    /// Safe-stop setpoints for every finger (DISABLED for a disabled one), E2E-protected, to
+    /// send at once when the bus comes back after a failure rather than at the next tick. Only
+    /// when the outputs are not enabled (a bus failure latches SAFE); otherwise nothing, as the
+    /// next tick carries the running setpoints. No allocation.
+    pub fn safe_stop_frames(&mut self) -> &[CanFrame] {
+        self.tx.clear();
+        if !self.safety.outputs_enabled() {
+            self.build_setpoints(false);
+        }
+        self.tx.frames()
+    }
+}
