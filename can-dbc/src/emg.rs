@@ -178,11 +178,15 @@ pub struct EmgConfig {
     pub max_gap_us: u64,
 }
 
+/// Default longest silence or counter jump that is bridged, µs: the daemon, sessions read from
+/// candump logs and replay all use it.
+pub const DEFAULT_MAX_GAP_US: u64 = 20_000;
+
 impl Default for EmgConfig {
     fn default() -> Self {
         Self {
             sample_period_us: 1000,
-            max_gap_us: 20_000,
+            max_gap_us: DEFAULT_MAX_GAP_US,
         }
     }
 }

@@ -10,7 +10,8 @@
 //! 2. decode into an [`EmgFrame`];
 //! 3. reassembly by counter ([`EmgAssembler`]): reordering tolerated, short losses bridged, a
 //!    gap over [`EmgFrontConfig::max_gap_us`] reported on the next sample;
-//! 4. rail detection (raw values outside `RAIL_LOW..RAIL_HIGH` are at the ADC's rails) and
+//! 4. rail detection (a raw value equal to [`crate::hand::ADC_MIN`] or [`crate::hand::ADC_MAX`]
+//!    is at a rail of the 12-bit ADC, [`crate::hand::at_rail`]) and
 //!    conversion to µV ([`EMG_LSB_UV`]).
 //!
 //! Settings are validated once ([`EmgFrontSettings::try_new`]); after that nothing returns a
@@ -24,20 +25,14 @@ use crate::emg::{
     EmgAssembler, EmgConfig, EmgConfigError, EmgFrame, EmgSample, EMG_CHANNELS, EMG_GROUPS,
     EMG_LSB_UV,
 };
+use crate::hand::at_rail;
 use crate::messages::{EmgSamplesG0, EmgSamplesG1, EmgSamplesG2};
 use crate::CanFrame;
 
-// Single source of the ADC rails (until hand.dbc names them): raw values in
-// `RAIL_LOW..RAIL_HIGH` are unclipped; anything else is at a rail of the 12-bit ADC.
-/// Lowest unclipped raw EMG value.
-pub const RAIL_LOW: i16 = -2047;
-/// Raw EMG values at or above this are at the upper rail.
-pub const RAIL_HIGH: i16 = 2047;
 /// Default counter step the E2E check accepts as a loss rather than a broken sequence: the
 /// counter is 8 bits at 1 kHz, and up to 20 lost samples are bridged.
 pub const DEFAULT_COUNTER_DELTA: u16 = 20;
-/// Default longest silence or counter jump that is bridged, µs (the daemon's default too).
-pub const DEFAULT_MAX_GAP_US: u64 = 20_000;
+pub use crate::emg::DEFAULT_MAX_GAP_US;
 
 /// The ids of EMG_SAMPLES_G0..G2, by group.
 const GROUP_IDS: [u32; EMG_GROUPS] = [EmgSamplesG0::ID, EmgSamplesG1::ID, EmgSamplesG2::ID];
@@ -278,7 +273,7 @@ fn convert(s: &EmgSample, channels: usize, counters: &mut FrontCounters) -> Fron
         *out = f64::from(raw) * EMG_LSB_UV;
     }
     for &raw in &s.raw {
-        railed += u32::from(!(RAIL_LOW..RAIL_HIGH).contains(&raw));
+        railed += u32::from(at_rail(raw));
     }
     counters.samples += 1;
     counters.railed += u64::from(railed);

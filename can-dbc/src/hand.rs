@@ -20,8 +20,8 @@ pub const ADC_MIN: i16 = EmgSamplesG0::EMG0_RAW_MIN;
 /// Largest EMG ADC count (signed 12 bit): the raw maximum of `Emg0` in hand.dbc, 2047
 /// (5117.5 uV). It is the upper rail: a sample equal to it is clipped.
 ///
-/// So the unclipped samples are `ADC_MIN + 1..ADC_MAX` (the daemon's `[RAIL_LOW, RAIL_HIGH)`
-/// = `[-2047, 2047)`), and [`at_rail`] is true exactly for `ADC_MIN` and `ADC_MAX`.
+/// So the unclipped samples are `ADC_MIN + 1..ADC_MAX` (`[-2047, 2047)`), and [`at_rail`] is
+/// true exactly for `ADC_MIN` and `ADC_MAX`: the EMG front end counts railed samples with it.
 pub const ADC_MAX: i16 = EmgSamplesG0::EMG0_RAW_MAX;
 
 /// The index of a finger from its name (`"index"`, any case, surrounding blanks ignored) or its
@@ -71,7 +71,7 @@ mod tests {
         );
         assert_eq!(EmgSamplesG2::EMG11_RAW_MIN, ADC_MIN);
         assert_eq!(EmgSamplesG2::EMG11_RAW_MAX, ADC_MAX);
-        // At a rail exactly when outside the daemon's unclipped [RAIL_LOW, RAIL_HIGH).
+        // At a rail exactly when outside the unclipped [-2047, 2047).
         let unclipped = -2047..2047;
         assert!((i16::MIN..=i16::MAX).all(|r| at_rail(r) != unclipped.contains(&r)));
     }

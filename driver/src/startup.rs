@@ -117,7 +117,7 @@ pub fn engine_settings(config: &Config, model_id: u32) -> EngineSettings {
         emg_silence_us: config.timeouts.emg_silence_ms * 1000,
         finger_silence_us: config.timeouts.finger_silence_ms * 1000,
         recovery_us: config.timeouts.recovery_ms * 1000,
-        max_gap_us: 20_000,
+        max_gap_us: hand_dbc::emg::DEFAULT_MAX_GAP_US,
         deadline_slack_us: config.deadline_slack_ms * 1000,
         gains: std::array::from_fn::<_, N_FINGERS, _>(|f| config.fingers.get(f).gains()),
         model_id,

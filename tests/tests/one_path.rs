@@ -145,10 +145,9 @@ fn write_simulated_session(dir: &Path) {
         seed: 3,
         ..AmplifierConfig::default()
     };
-    let toml = run
-        .session_toml("frames.log", &signal)
-        .expect("session.toml");
-    std::fs::write(dir.join("session.toml"), toml).expect("write session.toml");
+    run.session_meta("frames.log", &signal)
+        .write(dir)
+        .expect("write session.toml");
     let cfg = WorldConfig {
         amplifier: AmplifierNodeConfig {
             signal,

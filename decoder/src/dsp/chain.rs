@@ -4,7 +4,7 @@ use super::config::{ChainSettings, FeatureSignal};
 use super::faults::{Faults, MAX_ABS_SAMPLE};
 use super::features::{features_into, FEATURES_PER_CHANNEL};
 
-/// Filter state smaller than this is set to exactly 0 (every [`FLUSH_EVERY`] samples). Without
+/// Filter state smaller than this is set to exactly 0 (every `FLUSH_EVERY` samples). Without
 /// it a silent channel's IIR state decays into subnormal numbers and stays there in a limit
 /// cycle, which makes every later operation on it slow (2x on this machine, far worse on some
 /// CPUs). 1e-150 keeps squares in the features normal too; the change to the output is below

@@ -3,7 +3,7 @@
 //! R²), text tables, the curves as CSV and (with the `plots` feature) PNG figures.
 //!
 //! The metric functions take plain slices and a prediction closure, so they know nothing of
-//! how a model was built; [`evaluate`] ties them to trained models and calibration sessions.
+//! how a model was built; [`evaluate_model`] ties them to trained models and calibration sessions.
 
 mod csv;
 mod direction;

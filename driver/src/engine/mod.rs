@@ -59,7 +59,7 @@ impl Default for EngineSettings {
             emg_silence_us: 100_000,
             finger_silence_us: 100_000,
             recovery_us: 500_000,
-            max_gap_us: 20_000,
+            max_gap_us: hand_dbc::emg::DEFAULT_MAX_GAP_US,
             deadline_slack_us: 5_000,
             gains: [FingerGains::default(); N_FINGERS],
             model_id: 0,
