@@ -2,6 +2,7 @@
 //! chain and the model every 50 ms, and sends per-finger setpoints to the motor controllers.
 //! See README.md ("Installing handd on the board") and `handd --help`.
 
+use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::AtomicBool;
@@ -38,18 +39,31 @@ struct Args {
     check: bool,
 }
 
+/// Whether the human-readable log may carry ANSI colours: only on a terminal, never in JSON
+/// logs, and never when `NO_COLOR` is set to a non-empty value (<https://no-color.org>). Under
+/// systemd stderr is a pipe to the journal, so no escapes end up there.
+fn use_colour(json: bool, stderr_is_tty: bool, no_color: Option<&std::ffi::OsStr>) -> bool {
+    !json && stderr_is_tty && no_color.is_none_or(|v| v.is_empty())
+}
+
 fn init_logs(json: bool) {
     let filter = tracing_subscriber::EnvFilter::try_from_default_env()
         .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
+    let colour = use_colour(
+        json,
+        std::io::stderr().is_terminal(),
+        std::env::var_os("NO_COLOR").as_deref(),
+    );
     let builder = tracing_subscriber::fmt()
         .with_env_filter(filter)
-        .with_writer(std::io::stderr);
+        .with_writer(std::io::stderr)
+        .with_ansi(colour);
     // Under systemd the journal adds its own timestamps.
     let journald = std::env::var_os("JOURNAL_STREAM").is_some();
     if json {
         builder.json().init();
     } else if journald {
-        builder.without_time().with_ansi(false).init();
+        builder.without_time().init();
     } else {
         builder.init();
     }
@@ -61,8 +75,9 @@ fn main() -> ExitCode {
     match run(&args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            tracing::error!("{e}");
-            eprintln!("handd: refusing to start: {e}");
+            // Once, through the log: it reaches the terminal, the journal and a log collector
+            // alike (an extra eprintln! printed it a second time on the same stderr).
+            tracing::error!("refusing to start: {e}");
             ExitCode::from(2)
         }
     }
@@ -143,4 +158,28 @@ fn run(args: &Args) -> Result<(), String> {
     let _ = sd_notify::notify(&[sd_notify::NotifyState::Stopping]);
     tracing::info!("stopping");
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::use_colour;
+    use std::ffi::OsStr;
+
+    #[test]
+    fn colour_only_on_a_terminal_without_json_or_no_color() {
+        assert!(use_colour(false, true, None), "a terminal gets colours");
+        assert!(
+            !use_colour(false, false, None),
+            "a pipe (the journal) gets none"
+        );
+        assert!(!use_colour(true, true, None), "JSON logs get none");
+        assert!(
+            !use_colour(false, true, Some(OsStr::new("1"))),
+            "NO_COLOR=1 turns them off"
+        );
+        assert!(
+            use_colour(false, true, Some(OsStr::new(""))),
+            "an empty NO_COLOR is ignored, as no-color.org says"
+        );
+    }
 }
