@@ -4243,7 +4243,7 @@ impl HandDiag {
         Ok(())
     }
 
-    /// `DeadlineMisses` (count): Deadline misses since the previous HAND_DIAG (sender caps at 255).
+    /// `DeadlineMisses` (count): Deadline misses since handd started, modulo 256 (a wrapping total: 255 is followed by 0). A tool takes the difference of two frames modulo 256, which stays right across lost HAND_DIAG frames as long as fewer than 256 misses fall between them; the full count is in handctl status.
     pub fn deadline_misses(&self) -> u8 {
         self.deadline_misses
     }
@@ -4254,7 +4254,7 @@ impl HandDiag {
         Ok(())
     }
 
-    /// `EmgSamplesLost` (count): EMG samples lost since the previous HAND_DIAG (sender caps at 255).
+    /// `EmgSamplesLost` (count): EMG samples lost (and bridged) since handd started, modulo 256 (a wrapping total, as DeadlineMisses); the full count is in handctl status.
     pub fn emg_samples_lost(&self) -> u8 {
         self.emg_samples_lost
     }
@@ -5223,8 +5223,8 @@ pub const MESSAGES: &[MessageInfo] = &[
         comment: "handd diagnostics for the technician tool, 20 Hz, one per tick. Not safety relevant, so no E2E.",
         signals: &[
             SignalInfo { name: "TickLatency", start_bit: 0, size: 16, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 65535.0, raw_min: 0, raw_max: 65535, unit: "us", values: &[], comment: "Previous tick (this frame is built before its own tick's setpoints are written): receive time of the newest complete EMG sample it had to its setpoints written, us (sender caps at 65535). A replay finds the samples each tick had from it." },
-            SignalInfo { name: "DeadlineMisses", start_bit: 16, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "count", values: &[], comment: "Deadline misses since the previous HAND_DIAG (sender caps at 255)." },
-            SignalInfo { name: "EmgSamplesLost", start_bit: 24, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "count", values: &[], comment: "EMG samples lost since the previous HAND_DIAG (sender caps at 255)." },
+            SignalInfo { name: "DeadlineMisses", start_bit: 16, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "count", values: &[], comment: "Deadline misses since handd started, modulo 256 (a wrapping total: 255 is followed by 0). A tool takes the difference of two frames modulo 256, which stays right across lost HAND_DIAG frames as long as fewer than 256 misses fall between them; the full count is in handctl status." },
+            SignalInfo { name: "EmgSamplesLost", start_bit: 24, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "count", values: &[], comment: "EMG samples lost (and bridged) since handd started, modulo 256 (a wrapping total, as DeadlineMisses); the full count is in handctl status." },
             SignalInfo { name: "Label0", start_bit: 32, size: 6, signed: true, factor: 0.05, offset: 0.0, min: -1.0, max: 1.0, raw_min: -20, raw_max: 20, unit: "1", values: &[], comment: "Decoded label of finger 0 (thumb), flexion +1, extension -1, for display (0.05 steps)." },
             SignalInfo { name: "Label1", start_bit: 38, size: 6, signed: true, factor: 0.05, offset: 0.0, min: -1.0, max: 1.0, raw_min: -20, raw_max: 20, unit: "1", values: &[], comment: "Decoded label of finger 1 (index)." },
             SignalInfo { name: "Label2", start_bit: 44, size: 6, signed: true, factor: 0.05, offset: 0.0, min: -1.0, max: 1.0, raw_min: -20, raw_max: 20, unit: "1", values: &[], comment: "Decoded label of finger 2 (middle)." },

@@ -58,6 +58,12 @@ impl Tx {
     }
 }
 
+/// A total since start as HAND_DIAG carries it: modulo 256, a wrapping total (see hand.dbc),
+/// so a tool sees every increment by differencing, even across lost HAND_DIAG frames.
+fn wrapping_u8(total: u64) -> u8 {
+    (total % 256) as u8
+}
+
 impl Engine {
     /// The mode of finger `f` when the outputs are off: DISABLED if its controller is silent.
     fn stopped_mode(&self, f: usize) -> FingerMode {
@@ -99,8 +105,8 @@ impl Engine {
         };
         let diag = HandDiag::new(
             self.timing.last_latency_us.min(u64::from(u16::MAX)) as u16,
-            self.counters.deadline_misses.min(255) as u8,
-            self.counters.samples_lost.min(255) as u8,
+            wrapping_u8(self.counters.deadline_misses),
+            wrapping_u8(self.counters.samples_lost),
             shown(0),
             shown(1),
             shown(2),
@@ -148,5 +154,68 @@ impl Engine {
             self.build_setpoints(false);
         }
         self.tx.frames()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use decoder::dsp::ChainConfig;
+    use decoder::model::{
+        AnyModel, ModelKind, ModelSpec, Normalizer, TrainedModel, TrainingSummary,
+    };
+    use hand_dbc::messages::HandDiag;
+    use hand_dbc::CanFrame;
+
+    use crate::engine::{Engine, EngineSettings};
+
+    /// An engine in READY with a random model: no EMG ever comes, so the model never runs.
+    fn engine() -> Engine {
+        let chain = ChainConfig::default();
+        let n_in = 8 * chain.channels;
+        let spec = ModelSpec::default();
+        let model = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, 1).expect("model");
+        let norm = Normalizer::from_scales(vec![100.0; n_in]).expect("normalizer");
+        let summary = TrainingSummary::untrained(ModelKind::ResDd);
+        let predictor = TrainedModel::new(model, spec, norm, chain.clone(), summary)
+            .expect("trained model")
+            .predictor();
+        let chain = chain.validate().expect("chain");
+        let mut e = Engine::new(&chain, predictor, EngineSettings::default(), 0);
+        e.validated(0);
+        e
+    }
+
+    fn diag(frames: &[CanFrame]) -> HandDiag {
+        let frame = frames
+            .iter()
+            .find(|f| f.raw_id() == HandDiag::ID)
+            .expect("every tick sends HAND_DIAG");
+        HandDiag::decode(frame.data()).expect("HAND_DIAG decodes")
+    }
+
+    /// hand.dbc: DeadlineMisses and EmgSamplesLost are totals since start modulo 256.
+    #[test]
+    fn hand_diag_counters_are_totals_since_start_modulo_256() {
+        let mut e = engine();
+        let late = EngineSettings::default().deadline_slack_us + 1;
+        for n in 1..=300u64 {
+            let deadline = n * 50_000;
+            let d = diag(e.tick(deadline, deadline + late));
+            assert_eq!(
+                u64::from(d.deadline_misses()),
+                n % 256,
+                "DeadlineMisses after {n} misses"
+            );
+        }
+        let d = diag(e.tick(301 * 50_000, 301 * 50_000));
+        assert_eq!(d.deadline_misses(), 44, "an on-time tick adds nothing");
+        assert_eq!(e.counters().deadline_misses, 300, "the full count");
+
+        // Losing samples takes an EMG stream with gaps; the counter it feeds is set directly.
+        for (lost, expected) in [(255, 255), (256, 0), (511, 255), (600, 88)] {
+            e.counters.samples_lost = lost;
+            let d = diag(e.transmit());
+            assert_eq!(d.emg_samples_lost(), expected, "{lost} samples lost");
+        }
     }
 }
