@@ -145,8 +145,19 @@ impl<K: Clock> Transport for SocketCanTransport<K> {
     }
 
     fn drop_queued(&mut self) {
-        // Closing our socket discards what it still holds; the daemon writes nothing until the
-        // bus is reopened, and then only fresh setpoints of the SAFE state.
+        // Closing our socket stops this process writing until `reopen` (and then the daemon
+        // sends only SAFE-state setpoints), but it purges nothing: `send` hands each frame
+        // straight to the kernel, and a frame once written belongs to the interface, not to
+        // the socket. On a real controller, frames still in the interface's qdisc (pfifo_fast,
+        // txqueuelen 10 by default for CAN) or in the controller's transmit mailboxes can go
+        // out after the bus recovers: under error-passive the controller keeps retrying them;
+        // after bus-off it depends on the driver and the restart (a carrier drop resets the
+        // qdisc; a controller restart may or may not clear the mailboxes). Such a stale
+        // setpoint passes the motor controller's E2E check (its counter was in sequence) and
+        // is followed by our safe stops, not replaced by them. Purging needs CAP_NET_ADMIN,
+        // which handd does not use for this: `tc qdisc replace dev <if> root pfifo_fast`
+        // flushes the qdisc; `ip link set <if> down` stops the controller and drops what it
+        // holds. (vcan has no queue: nothing is ever pending there.)
         self.socket = None;
     }
 

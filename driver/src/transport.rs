@@ -35,8 +35,10 @@ pub trait Transport {
     fn try_recv(&mut self) -> Result<Option<Timestamped>, TransportError>;
     /// Send one frame now.
     fn send(&mut self, frame: &CanFrame) -> Result<(), TransportError>;
-    /// Drop every frame queued for sending and not yet on the bus (after bus-off, a stale
-    /// setpoint must never reach a motor).
+    /// After a bus failure: drop what this transport can of the frames queued for sending and
+    /// not yet on the bus (a stale setpoint should never reach a motor). What can be dropped
+    /// depends on the transport: SocketCAN cannot purge the kernel's and the controller's
+    /// queues (see its implementation).
     fn drop_queued(&mut self);
     /// Try to bring the bus back (reopen the socket).
     fn reopen(&mut self) -> Result<(), TransportError>;
