@@ -124,9 +124,60 @@ pub fn engine_settings(config: &Config, model_id: u32) -> EngineSettings {
     }
 }
 
+/// Removes what saves killed midway left beside `files` (the config, the model): temporary
+/// files whose writer process is gone ([`decoder::fsio::remove_stale_temps`]; a live writer's
+/// are kept). Each removal is logged; a failure is logged and never stops the start. Returns
+/// the files removed.
+pub fn remove_stale_temps(files: &[&Path]) -> Vec<PathBuf> {
+    let mut removed = Vec::new();
+    for file in files {
+        match decoder::fsio::remove_stale_temps(file) {
+            Ok(stale) => {
+                for t in stale {
+                    tracing::warn!(
+                        path = %t.path.display(),
+                        pid = t.pid,
+                        "removed the temporary file of a save that was killed midway"
+                    );
+                    removed.push(t.path);
+                }
+            }
+            Err(e) => tracing::warn!("temporary files beside {}: {e}", file.display()),
+        }
+    }
+    removed
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn stale_temporaries_of_the_config_and_the_model_go_a_live_writers_stay() {
+        let dir = std::env::temp_dir().join(format!("handd-stale-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("scratch directory");
+        let (config, model) = (dir.join("handd.toml"), dir.join("model.hsm"));
+        // 2^22 + 1 is above Linux's PID_MAX_LIMIT: no process has it.
+        let dead = (1u32 << 22) + 1;
+        let me = std::process::id();
+        let stale_config = dir.join(format!(".handd.toml.tmp.{dead}.3"));
+        let stale_model = dir.join(format!(".model.hsm.tmp.{dead}.0"));
+        let live = dir.join(format!(".handd.toml.tmp.{me}.1"));
+        for f in [&stale_config, &stale_model, &live] {
+            std::fs::write(f, b"half a save").expect("a temporary");
+        }
+        let mut removed = remove_stale_temps(&[&config, &model]);
+        removed.sort();
+        let mut expected = vec![stale_config, stale_model];
+        expected.sort();
+        assert_eq!(
+            removed, expected,
+            "the dead writers' temporaries are removed"
+        );
+        assert!(live.exists(), "the live writer's temporary stays");
+        std::fs::remove_dir_all(&dir).expect("clean up");
+    }
 
     #[test]
     fn fingerprint_is_fnv1a() {

@@ -18,7 +18,7 @@ use driver::engine::Engine;
 use driver::rt::{lock_memory, set_fifo, RtReport};
 use driver::service::ControlHandler;
 use driver::socketcan_bus::SocketCanTransport;
-use driver::startup::{engine_settings, load_model};
+use driver::startup::{engine_settings, load_model, remove_stale_temps};
 use hand_clock::{Clock, SystemClock};
 
 /// The handstack daemon.
@@ -105,6 +105,8 @@ fn run(args: &Args) -> Result<(), String> {
         );
         return Ok(());
     }
+    // Saves killed midway (a writer's .tmp.PID files) are cleaned up before anything runs.
+    remove_stale_temps(&[&args.config, &config.model]);
 
     let mut rt = RtReport::default();
     lock_memory(&mut rt);
