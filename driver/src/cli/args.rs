@@ -166,7 +166,8 @@ pub struct EvalArgs {
 /// `handctl import-3dc`.
 #[derive(Debug, Args)]
 pub struct Import3dcArgs {
-    /// Directory holding P4_{train,test}_emg.npy and P4_{train,test}_index.csv.
+    /// Directory holding one participant's P<n>_{train,test}_emg.npy and
+    /// P<n>_{train,test}_index.csv (P4, P6, P7, ...).
     pub dir: PathBuf,
     /// Which half of the recordings.
     #[arg(long, value_parser = ["train", "test"])]
