@@ -5,6 +5,9 @@
 //!   reach the front end's full scale (only when the session states its full scale).
 //! * **Flat channel** (lead-off, broken wire): the raw signal does not move at all, or its
 //!   windowed RMS is below `flat_ratio` times the median channel of the same trial.
+//! * **Noisy electrode**: a channel's rest level (mean windowed RMS over the rest trials) is
+//!   above `noisy_ratio` times the median of the other channels' rest levels: a loose or
+//!   badly seated electrode picks up noise; reported once per channel, on the first rest trial.
 //! * **Too little contrast**: a flexion or extension trial's mean RMS (over channels and
 //!   windows) is below `min_contrast` times the mean of the rest trials.
 //! * **Weak repetition**: a trial's mean RMS is below `min_repeat_ratio` times the strongest
@@ -23,6 +26,8 @@ pub struct GateConfig {
     pub saturation_fraction: f64,
     /// A channel whose RMS is below this fraction of the trial's median channel is flat.
     pub flat_ratio: f64,
+    /// A channel whose rest RMS is above this multiple of the other channels' median is noisy.
+    pub noisy_ratio: f64,
     /// Minimum ratio of a contraction's mean RMS to rest's.
     pub min_contrast: f64,
     /// Minimum ratio of a trial's mean RMS to its strongest repetition's.
@@ -34,6 +39,7 @@ impl Default for GateConfig {
         Self {
             saturation_fraction: 0.01,
             flat_ratio: 0.02,
+            noisy_ratio: 5.0,
             min_contrast: 1.5,
             min_repeat_ratio: 0.5,
         }
@@ -50,6 +56,11 @@ pub enum GateKind {
     },
     /// A channel does not move (lead-off).
     Flat {
+        /// Channel index.
+        channel: usize,
+    },
+    /// A channel is much noisier than the others at rest (a badly seated electrode).
+    Noisy {
         /// Channel index.
         channel: usize,
     },
@@ -100,6 +111,54 @@ impl std::fmt::Display for GateReport {
             writeln!(f, "all quality gates passed")?;
         }
         Ok(())
+    }
+}
+
+/// The noisy-electrode gate: `rms[trial][channel]` is the mean windowed RMS, `count[trial]`
+/// its windows.
+fn noisy_at_rest(
+    rms: &[Vec<f64>],
+    count: &[usize],
+    trials: &[super::trial::Trial],
+    config: &GateConfig,
+    report: &mut GateReport,
+) {
+    let rest: Vec<usize> = (0..trials.len())
+        .filter(|&i| trials[i].kind == TrialKind::Rest && count[i] > 0)
+        .collect();
+    let (Some(&first), Some(ch)) = (rest.first(), rms.first().map(Vec::len)) else {
+        return;
+    };
+    if ch < 2 {
+        return;
+    }
+    let windows: usize = rest.iter().map(|&i| count[i]).sum();
+    let level: Vec<f64> = (0..ch)
+        .map(|c| {
+            rest.iter()
+                .map(|&i| rms[i][c] * count[i] as f64)
+                .sum::<f64>()
+                / windows as f64
+        })
+        .collect();
+    for (c, &own) in level.iter().enumerate() {
+        let mut others: Vec<f64> = (0..ch).filter(|&o| o != c).map(|o| level[o]).collect();
+        others.sort_by(f64::total_cmp);
+        let median = others[others.len() / 2];
+        if own > config.noisy_ratio * median {
+            report.issues.push(GateIssue {
+                trial_id: trials[first].id,
+                kind: GateKind::Noisy { channel: c },
+                message: format!(
+                    "{}: channel {c} is noisy at rest (RMS {own:.3}, {:.1}x the median of the \
+                     other channels, {median:.3}; limit {}x): re-seat that electrode (clean \
+                     skin, firm contact), then record the calibration again",
+                    trials[first],
+                    own / median,
+                    config.noisy_ratio
+                ),
+            });
+        }
     }
 }
 
@@ -184,6 +243,8 @@ pub fn check_gates(session: &Session, config: &GateConfig) -> Result<GateReport,
             }
         }
     }
+
+    noisy_at_rest(&rms, &count, trials, config, &mut report);
 
     // Contrast against rest.
     let rest: Vec<usize> = (0..trials.len())
