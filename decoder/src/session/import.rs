@@ -130,6 +130,33 @@ fn three_dc_participant(dir: &Path, split: Split) -> Result<String, SessionError
     }
 }
 
+/// The 3DC armband's signal chain: 10 channels at 1 kHz.
+fn three_dc_chain() -> ChainConfig {
+    ChainConfig {
+        channels: THREE_DC_CHANNELS,
+        sample_rate_hz: 1000.0,
+        // Recorded in Canada; the recordings show no mains line either way.
+        mains_hz: 60,
+        ..ChainConfig::default()
+    }
+}
+
+/// Positions of rep, gesture_id, start_sample and end_sample_exclusive in the index's header.
+fn index_columns(header: &str, index: &Path) -> Result<[usize; 4], SessionError> {
+    let cols: Vec<&str> = header.split(',').map(str::trim).collect();
+    let col = |name: &str| {
+        cols.iter().position(|c| *c == name).ok_or_else(|| {
+            SessionError::invalid(index, format!("line 1: no column \"{name}\" in the header"))
+        })
+    };
+    Ok([
+        col("rep")?,
+        col("gesture_id")?,
+        col("start_sample")?,
+        col("end_sample_exclusive")?,
+    ])
+}
+
 fn three_dc_meta(dir: &Path, split: Split) -> Result<(SessionMeta, PathBuf), SessionError> {
     let who = three_dc_participant(dir, split)?;
     let npy = dir.join(format!("{who}_{}_emg.npy", split.name()));
@@ -137,28 +164,7 @@ fn three_dc_meta(dir: &Path, split: Split) -> Result<(SessionMeta, PathBuf), Ses
     let text = read_text(&index)?;
     let mut lines = text.lines().enumerate();
     let header = lines.next().map(|(_, h)| h).unwrap_or("");
-    let cols: Vec<&str> = header.split(',').map(str::trim).collect();
-    let col = |name: &str| {
-        cols.iter().position(|c| *c == name).ok_or_else(|| {
-            SessionError::invalid(
-                &index,
-                format!("line 1: no column \"{name}\" in the header"),
-            )
-        })
-    };
-    let (c_rep, c_gesture, c_start, c_end) = (
-        col("rep")?,
-        col("gesture_id")?,
-        col("start_sample")?,
-        col("end_sample_exclusive")?,
-    );
-    let chain = ChainConfig {
-        channels: THREE_DC_CHANNELS,
-        sample_rate_hz: 1000.0,
-        // Recorded in Canada; the recordings show no mains line either way.
-        mains_hz: 60,
-        ..ChainConfig::default()
-    };
+    let [c_rep, c_gesture, c_start, c_end] = index_columns(header, &index)?;
     let us = |s: u64| s * 1000;
     let mut trials = Vec::new();
     let mut segments = Vec::new();
@@ -197,7 +203,7 @@ fn three_dc_meta(dir: &Path, split: Split) -> Result<(SessionMeta, PathBuf), Ses
         });
     }
     let meta = SessionMeta {
-        chain,
+        chain: three_dc_chain(),
         onset_skip_ms: THREE_DC_ONSET_SKIP_MS,
         recording: RecordingSpec {
             format: RecordingFormat::Npy,
