@@ -3,7 +3,7 @@
 //! An effort ray scales a calibration window's signal by `k` in `[0, 1]`: the amplitude
 //! features scale by `k`, VAR by `k²`, the normalizer is scale-only and ResDD and LN are
 //! bias-free polynomial maps, so each finger's output is a polynomial in `k`
-//! ([`propagate`](self) builds it layer by layer in `f64`). Its largest reversal against the
+//! (`propagate.rs` builds it layer by layer in `f64`). Its largest reversal against the
 //! trial's direction, `max dir·(y(k1) - y(k2))` over `k1 < k2`, is read at its critical points,
 //! the real roots of `y'` in `[0, 1]`, found by Bernstein subdivision (see `roots.rs`: a
 //! root-free interval is proven root-free, never assumed). The models have no output clamp or
