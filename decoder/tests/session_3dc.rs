@@ -53,6 +53,25 @@ fn both_splits_load_as_sessions() {
 }
 
 #[test]
+fn any_participant_loads() {
+    let shared = data_dir().join("..");
+    for who in ["P6", "P7"] {
+        let dir = shared.join(format!("3dc-armband-{}", who.to_lowercase()));
+        let s = load_3dc(&dir, Split::Train).unwrap();
+        assert_eq!(s.recording.channels, 10, "{who}");
+        assert_eq!(s.meta.trials.len(), 12, "{who}");
+        assert!(
+            s.meta.recording.file.to_string_lossy().contains(who),
+            "{who}: {}",
+            s.meta.recording.file.display()
+        );
+    }
+    // A directory without 3DC recordings names what it looked for.
+    let err = load_3dc(Path::new(env!("CARGO_MANIFEST_DIR")), Split::Test).unwrap_err();
+    assert!(err.to_string().contains("P<n>_test_emg.npy"), "{err}");
+}
+
+#[test]
 fn import_writes_a_session_that_opens_the_same() {
     let out = std::env::temp_dir().join(format!("handstack-3dc-import-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);

@@ -2,7 +2,7 @@
 
 mod session_support;
 
-use decoder::session::{check_gates, GateConfig, GateKind, Session, SessionMeta};
+use decoder::session::{check_gates, GateConfig, GateKind, Session, SessionMeta, TrialKind};
 use session_support::*;
 
 fn session_of(
@@ -71,6 +71,39 @@ fn a_flat_channel_is_caught() {
     );
     assert!(r.issues.iter().all(|i| i.trial_id == 4), "{r}");
     assert!(r.to_string().contains("channel 3 is flat"), "{r}");
+}
+
+#[test]
+fn a_noisy_electrode_is_caught_and_named() {
+    let mut trials = clean_protocol();
+    // Channel 1 picks up eight times the others' noise at rest: a loose electrode.
+    for t in trials.iter_mut().filter(|t| t.kind == TrialKind::Rest) {
+        t.amps[1] = 8.0 * REST_AMP;
+    }
+    let s = session_of(&trials, 15, |_, _| {});
+    let r = check_gates(&s, &GateConfig::default()).unwrap();
+    let noisy: Vec<_> = r
+        .issues
+        .iter()
+        .filter(|i| matches!(i.kind, GateKind::Noisy { .. }))
+        .collect();
+    assert_eq!(noisy.len(), 1, "{r}");
+    assert_eq!(noisy[0].kind, GateKind::Noisy { channel: 1 });
+    assert_eq!(noisy[0].trial_id, 1, "reported on the first rest trial");
+    let m = &noisy[0].message;
+    assert!(
+        m.contains("channel 1 is noisy") && m.contains("re-seat"),
+        "{m}"
+    );
+    // The clean protocol has no noisy channel (a_clean_session_passes checks every gate).
+    let clean = session_of(&clean_protocol(), 15, |_, _| {});
+    let r = check_gates(&clean, &GateConfig::default()).unwrap();
+    assert!(
+        !r.issues
+            .iter()
+            .any(|i| matches!(i.kind, GateKind::Noisy { .. })),
+        "{r}"
+    );
 }
 
 #[test]

@@ -123,6 +123,43 @@ fn import_train_and_eval_on_the_3dc_proxy() {
 }
 
 #[test]
+fn train_then_verify_the_effort_rays() {
+    // Another participant's recordings, named directly: the loader reads the P6_ prefix.
+    let spec = format!("3dc:{}/../3dc-armband-p6:test", data_dir().display());
+    let dir = tmp("verify");
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = dir.join("ln.hsm");
+    let out = handctl(&[
+        "train",
+        &spec,
+        "--model",
+        "ln",
+        "-o",
+        s(&model),
+        "--epochs",
+        "3",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let o = text(&out.stdout);
+    assert!(
+        o.contains("effort rays (exact):") && o.contains("training rays"),
+        "{o}"
+    );
+
+    let out = handctl(&["verify", "--model", s(&model), &spec]);
+    let o = text(&out.stdout);
+    assert!(o.contains("ln effort-ray check, exact"), "{o}");
+    assert!(o.contains("rays checked"), "{o}");
+    let reverses = o.contains("REVERSES");
+    // Exit 0 exactly when no ray reverses; otherwise 1 with the count on stderr.
+    assert_eq!(out.status.code(), Some(if reverses { 1 } else { 0 }), "{o}");
+    if reverses {
+        assert!(text(&out.stderr).contains("reverse beyond the tolerance"));
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn errors_are_clear() {
     let out = handctl(&["train", "/nonexistent/session", "-o", "/tmp/x.hsm"]);
     assert_eq!(out.status.code(), Some(1));

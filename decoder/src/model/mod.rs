@@ -32,6 +32,7 @@ mod summary;
 mod train;
 mod trained;
 mod traits;
+pub mod verify;
 
 pub use any::AnyModel;
 pub use cnn::Cnn;

@@ -5,13 +5,16 @@
 //!   reach the front end's full scale (only when the session states its full scale).
 //! * **Flat channel** (lead-off, broken wire): the raw signal does not move at all, or its
 //!   windowed RMS is below `flat_ratio` times the median channel of the same trial.
+//! * **Noisy electrode**: a channel's rest level (mean windowed RMS over the rest trials) is
+//!   above `noisy_ratio` times the median of the other channels' rest levels: a loose or
+//!   badly seated electrode picks up noise; reported once per channel, on the first rest trial.
 //! * **Too little contrast**: a flexion or extension trial's mean RMS (over channels and
 //!   windows) is below `min_contrast` times the mean of the rest trials.
 //! * **Weak repetition**: a trial's mean RMS is below `min_repeat_ratio` times the strongest
 //!   repetition of the same finger and kind.
 
 use super::error::SessionError;
-use super::trial::TrialKind;
+use super::trial::{Trial, TrialKind};
 use super::windows::WindowOptions;
 use super::Session;
 use crate::dsp::FEATURES_PER_CHANNEL;
@@ -23,6 +26,8 @@ pub struct GateConfig {
     pub saturation_fraction: f64,
     /// A channel whose RMS is below this fraction of the trial's median channel is flat.
     pub flat_ratio: f64,
+    /// A channel whose rest RMS is above this multiple of the other channels' median is noisy.
+    pub noisy_ratio: f64,
     /// Minimum ratio of a contraction's mean RMS to rest's.
     pub min_contrast: f64,
     /// Minimum ratio of a trial's mean RMS to its strongest repetition's.
@@ -34,6 +39,7 @@ impl Default for GateConfig {
         Self {
             saturation_fraction: 0.01,
             flat_ratio: 0.02,
+            noisy_ratio: 5.0,
             min_contrast: 1.5,
             min_repeat_ratio: 0.5,
         }
@@ -50,6 +56,11 @@ pub enum GateKind {
     },
     /// A channel does not move (lead-off).
     Flat {
+        /// Channel index.
+        channel: usize,
+    },
+    /// A channel is much noisier than the others at rest (a badly seated electrode).
+    Noisy {
         /// Channel index.
         channel: usize,
     },
@@ -103,16 +114,92 @@ impl std::fmt::Display for GateReport {
     }
 }
 
+/// The noisy-electrode gate: `rms[trial][channel]` is the mean windowed RMS, `count[trial]`
+/// its windows.
+fn noisy_at_rest(
+    rms: &[Vec<f64>],
+    count: &[usize],
+    trials: &[Trial],
+    config: &GateConfig,
+    report: &mut GateReport,
+) {
+    let rest: Vec<usize> = (0..trials.len())
+        .filter(|&i| trials[i].kind == TrialKind::Rest && count[i] > 0)
+        .collect();
+    let (Some(&first), Some(ch)) = (rest.first(), rms.first().map(Vec::len)) else {
+        return;
+    };
+    if ch < 2 {
+        return;
+    }
+    let windows: usize = rest.iter().map(|&i| count[i]).sum();
+    let level: Vec<f64> = (0..ch)
+        .map(|c| {
+            rest.iter()
+                .map(|&i| rms[i][c] * count[i] as f64)
+                .sum::<f64>()
+                / windows as f64
+        })
+        .collect();
+    for (c, &own) in level.iter().enumerate() {
+        let mut others: Vec<f64> = (0..ch).filter(|&o| o != c).map(|o| level[o]).collect();
+        others.sort_by(f64::total_cmp);
+        let median = others[others.len() / 2];
+        if own > config.noisy_ratio * median {
+            report.issues.push(GateIssue {
+                trial_id: trials[first].id,
+                kind: GateKind::Noisy { channel: c },
+                message: format!(
+                    "{}: channel {c} is noisy at rest (RMS {own:.3}, {:.1}x the median of the \
+                     other channels, {median:.3}; limit {}x): re-seat that electrode (clean \
+                     skin, firm contact), then record the calibration again",
+                    trials[first],
+                    own / median,
+                    config.noisy_ratio
+                ),
+            });
+        }
+    }
+}
+
 /// Runs every gate over a session.
 pub fn check_gates(session: &Session, config: &GateConfig) -> Result<GateReport, SessionError> {
     let windows = session.windows(&WindowOptions { two_point: false })?;
-    let ch = session.recording.channels;
     let trials = &session.meta.trials;
     let mut report = GateReport::default();
+    let (rms, count) = trial_rms(&windows, session.recording.channels, trials.len());
+    let strength: Vec<f64> = rms
+        .iter()
+        .map(|r| r.iter().sum::<f64>() / r.len().max(1) as f64)
+        .collect();
+    for (ti, t) in trials.iter().enumerate() {
+        if count[ti] == 0 {
+            report.issues.push(GateIssue {
+                trial_id: t.id,
+                kind: GateKind::NoWindows,
+                message: format!(
+                    "{t}: too short to give a single feature window; record it again, longer"
+                ),
+            });
+            continue;
+        }
+        channel_gates(session, config, t, &rms[ti], &mut report);
+    }
+    noisy_at_rest(&rms, &count, trials, config, &mut report);
+    contrast_gate(trials, &strength, &count, config, &mut report);
+    repeat_gate(trials, &strength, &count, config, &mut report);
+    report.issues.sort_by_key(|i| i.trial_id);
+    Ok(report)
+}
 
-    // Per trial, per channel: mean windowed RMS.
-    let mut rms = vec![vec![0.0; ch]; trials.len()];
-    let mut count = vec![0usize; trials.len()];
+/// Per trial, per channel: the mean windowed RMS; and each trial's window count.
+fn trial_rms(
+    windows: &super::windows::LabelledWindows,
+    ch: usize,
+    n_trials: usize,
+) -> (Vec<Vec<f64>>, Vec<usize>) {
+    let mut rms = vec![vec![0.0; ch]; n_trials];
+    let mut count = vec![0usize; n_trials];
     for (i, l) in windows.labels.iter().enumerate() {
         let row = windows.row(i);
         for (c, r) in rms[l.trial].iter_mut().enumerate() {
@@ -125,67 +212,70 @@ pub fn check_gates(session: &Session, config: &GateConfig) -> Result<GateReport,
             r.iter_mut().for_each(|v| *v /= n as f64);
         }
     }
-    let strength: Vec<f64> = rms
-        .iter()
-        .map(|r| r.iter().sum::<f64>() / ch as f64)
-        .collect();
+    (rms, count)
+}
 
-    for (ti, t) in trials.iter().enumerate() {
-        if count[ti] == 0 {
-            report.issues.push(GateIssue {
-                trial_id: t.id,
-                kind: GateKind::NoWindows,
-                message: format!(
-                    "{t}: too short to give a single feature window; record it again, longer"
-                ),
+/// The saturation and flat-channel gates of one trial (`rms`: its channels' mean RMS).
+fn channel_gates(
+    session: &Session,
+    config: &GateConfig,
+    t: &Trial,
+    rms: &[f64],
+    report: &mut GateReport,
+) {
+    let ch = rms.len();
+    let range = session.recording.range_of(t.start_us, t.end_us);
+    let raw = session.recording.slice(range.clone());
+    let n = range.len().max(1);
+    let mut median = rms.to_vec();
+    median.sort_by(f64::total_cmp);
+    let median = median[ch / 2];
+    for (c, &chan_rms) in rms.iter().enumerate() {
+        let column = raw.iter().skip(c).step_by(ch);
+        let (lo, hi) = column
+            .clone()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
+                (lo.min(v), hi.max(v))
             });
-            continue;
-        }
-        let range = session.recording.range_of(t.start_us, t.end_us);
-        let raw = session.recording.slice(range.clone());
-        let n = range.len().max(1);
-        let mut median = rms[ti].clone();
-        median.sort_by(f64::total_cmp);
-        let median = median[ch / 2];
-        for (c, &chan_rms) in rms[ti].iter().enumerate() {
-            let column = raw.iter().skip(c).step_by(ch);
-            let (lo, hi) = column
-                .clone()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-                    (lo.min(v), hi.max(v))
-                });
-            if let Some(fs) = session.meta.recording.full_scale {
-                let rail = fs * session.recording.unit_per_raw;
-                let at_rail = column.filter(|v| v.abs() >= rail).count();
-                let frac = at_rail as f64 / n as f64;
-                if frac > config.saturation_fraction {
-                    report.issues.push(GateIssue {
-                        trial_id: t.id,
-                        kind: GateKind::Saturated { channel: c },
-                        message: format!(
-                            "{t}: channel {c} is saturated in {:.1}% of samples (full scale {fs}); \
-                             lower the gain or check the electrode, then record the trial again",
-                            100.0 * frac
-                        ),
-                    });
-                    continue;
-                }
-            }
-            if hi <= lo || chan_rms < config.flat_ratio * median {
+        if let Some(fs) = session.meta.recording.full_scale {
+            let rail = fs * session.recording.unit_per_raw;
+            let at_rail = column.filter(|v| v.abs() >= rail).count();
+            let frac = at_rail as f64 / n as f64;
+            if frac > config.saturation_fraction {
                 report.issues.push(GateIssue {
                     trial_id: t.id,
-                    kind: GateKind::Flat { channel: c },
+                    kind: GateKind::Saturated { channel: c },
                     message: format!(
-                        "{t}: channel {c} is flat (RMS {:.3} against a median channel of {:.3}): \
-                         electrode off or lead broken; fix the electrode, then record the trial again",
-                        chan_rms, median
+                        "{t}: channel {c} is saturated in {:.1}% of samples (full scale {fs}); \
+                         lower the gain or check the electrode, then record the trial again",
+                        100.0 * frac
                     ),
                 });
+                continue;
             }
         }
+        if hi <= lo || chan_rms < config.flat_ratio * median {
+            report.issues.push(GateIssue {
+                trial_id: t.id,
+                kind: GateKind::Flat { channel: c },
+                message: format!(
+                    "{t}: channel {c} is flat (RMS {:.3} against a median channel of {:.3}): \
+                     electrode off or lead broken; fix the electrode, then record the trial again",
+                    chan_rms, median
+                ),
+            });
+        }
     }
+}
 
-    // Contrast against rest.
+/// Contrast against rest: each contraction's mean RMS against the rest trials'.
+fn contrast_gate(
+    trials: &[Trial],
+    strength: &[f64],
+    count: &[usize],
+    config: &GateConfig,
+    report: &mut GateReport,
+) {
     let rest: Vec<usize> = (0..trials.len())
         .filter(|&i| trials[i].kind == TrialKind::Rest && count[i] > 0)
         .collect();
@@ -193,28 +283,36 @@ pub fn check_gates(session: &Session, config: &GateConfig) -> Result<GateReport,
         report
             .notes
             .push("no rest trial: the contrast gate did not run".into());
-    } else {
-        let rest_strength = rest.iter().map(|&i| strength[i]).sum::<f64>() / rest.len() as f64;
-        for (ti, t) in trials.iter().enumerate() {
-            if t.kind == TrialKind::Rest || count[ti] == 0 {
-                continue;
-            }
-            let ratio = strength[ti] / rest_strength;
-            if ratio.is_nan() || ratio < config.min_contrast {
-                report.issues.push(GateIssue {
-                    trial_id: t.id,
-                    kind: GateKind::LowContrast,
-                    message: format!(
-                        "{t}: only {ratio:.2}x the RMS of rest (needs {:.2}x): \
-                         record it again with a maximal contraction",
-                        config.min_contrast
-                    ),
-                });
-            }
+        return;
+    }
+    let rest_strength = rest.iter().map(|&i| strength[i]).sum::<f64>() / rest.len() as f64;
+    for (ti, t) in trials.iter().enumerate() {
+        if t.kind == TrialKind::Rest || count[ti] == 0 {
+            continue;
+        }
+        let ratio = strength[ti] / rest_strength;
+        if ratio.is_nan() || ratio < config.min_contrast {
+            report.issues.push(GateIssue {
+                trial_id: t.id,
+                kind: GateKind::LowContrast,
+                message: format!(
+                    "{t}: only {ratio:.2}x the RMS of rest (needs {:.2}x): \
+                     record it again with a maximal contraction",
+                    config.min_contrast
+                ),
+            });
         }
     }
+}
 
-    // Repeatability within (finger, kind).
+/// Repeatability within (finger, kind): each trial against its strongest other repetition.
+fn repeat_gate(
+    trials: &[Trial],
+    strength: &[f64],
+    count: &[usize],
+    config: &GateConfig,
+    report: &mut GateReport,
+) {
     for (ti, t) in trials.iter().enumerate() {
         if t.kind == TrialKind::Rest || count[ti] == 0 {
             continue;
@@ -238,6 +336,4 @@ pub fn check_gates(session: &Session, config: &GateConfig) -> Result<GateReport,
             }
         }
     }
-    report.issues.sort_by_key(|i| i.trial_id);
-    Ok(report)
 }

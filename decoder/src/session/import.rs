@@ -4,7 +4,8 @@
 //!   line, optional header), plus a label table CSV with the header
 //!   `finger,kind,repetition,start_sample,end_sample` (an `id` column is optional; finger is
 //!   0..4, a finger name or `all`; kind is flexion, extension or rest).
-//! * The 3DC armband recordings (`../shared/data/3dc-armband-p4`) as a proxy calibration: Power
+//! * The 3DC armband recordings (`../shared/data/3dc-armband-p{4,6,7}`, any participant: the
+//!   files' `P<n>_` prefix is read from the directory) as a proxy calibration: Power
 //!   Grip (gesture 7) = all fingers +1, Open Hand (8) = all fingers -1, Neutral (0) = rest. Each
 //!   of its recordings is a separate segment, filtered on its own.
 
@@ -21,9 +22,9 @@ use crate::dsp::ChainConfig;
 /// Which half of the 3DC recordings.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Split {
-    /// `P4_train_*`.
+    /// `P<n>_train_*`.
     Train,
-    /// `P4_test_*`.
+    /// `P<n>_test_*`.
     Test,
 }
 
@@ -57,7 +58,8 @@ pub enum SessionSpec {
     Dir(PathBuf),
     /// `3dc:DIR:SPLIT`: the 3DC recordings read directly.
     ThreeDc {
-        /// Directory holding `P4_{split}_emg.npy` and `P4_{split}_index.csv`.
+        /// Directory holding one participant's `P<n>_{split}_emg.npy` and
+        /// `P<n>_{split}_index.csv`.
         dir: PathBuf,
         /// Which half.
         split: Split,
@@ -96,34 +98,73 @@ fn read_text(path: &Path) -> Result<String, SessionError> {
     std::fs::read_to_string(path).map_err(|e| SessionError::io(path, e))
 }
 
-fn three_dc_meta(dir: &Path, split: Split) -> Result<(SessionMeta, PathBuf), SessionError> {
-    let npy = dir.join(format!("P4_{}_emg.npy", split.name()));
-    let index = dir.join(format!("P4_{}_index.csv", split.name()));
-    let text = read_text(&index)?;
-    let mut lines = text.lines().enumerate();
-    let header = lines.next().map(|(_, h)| h).unwrap_or("");
-    let cols: Vec<&str> = header.split(',').map(str::trim).collect();
-    let col = |name: &str| {
-        cols.iter().position(|c| *c == name).ok_or_else(|| {
-            SessionError::invalid(
-                &index,
-                format!("line 1: no column \"{name}\" in the header"),
-            )
-        })
-    };
-    let (c_rep, c_gesture, c_start, c_end) = (
-        col("rep")?,
-        col("gesture_id")?,
-        col("start_sample")?,
-        col("end_sample_exclusive")?,
-    );
-    let chain = ChainConfig {
+/// The participant prefix (`P4`, `P6`, ...) of the one `P<n>_{split}_emg.npy` in `dir`.
+fn three_dc_participant(dir: &Path, split: Split) -> Result<String, SessionError> {
+    let suffix = format!("_{}_emg.npy", split.name());
+    let entries = std::fs::read_dir(dir).map_err(|e| SessionError::io(dir, e))?;
+    let mut found = Vec::new();
+    for entry in entries {
+        let name = entry.map_err(|e| SessionError::io(dir, e))?.file_name();
+        let Some(prefix) = name.to_str().and_then(|n| n.strip_suffix(&suffix)) else {
+            continue;
+        };
+        let digits = prefix.strip_prefix('P').unwrap_or("");
+        if !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit()) {
+            found.push(prefix.to_string());
+        }
+    }
+    found.sort();
+    match found.as_slice() {
+        [one] => Ok(one.clone()),
+        [] => Err(SessionError::invalid(
+            dir,
+            format!("no 3DC recording P<n>{suffix} in this directory"),
+        )),
+        many => Err(SessionError::invalid(
+            dir,
+            format!(
+                "several participants' 3DC recordings ({}): keep one per directory",
+                many.join(", ")
+            ),
+        )),
+    }
+}
+
+/// The 3DC armband's signal chain: 10 channels at 1 kHz.
+fn three_dc_chain() -> ChainConfig {
+    ChainConfig {
         channels: THREE_DC_CHANNELS,
         sample_rate_hz: 1000.0,
         // Recorded in Canada; the recordings show no mains line either way.
         mains_hz: 60,
         ..ChainConfig::default()
+    }
+}
+
+/// Positions of rep, gesture_id, start_sample and end_sample_exclusive in the index's header.
+fn index_columns(header: &str, index: &Path) -> Result<[usize; 4], SessionError> {
+    let cols: Vec<&str> = header.split(',').map(str::trim).collect();
+    let col = |name: &str| {
+        cols.iter().position(|c| *c == name).ok_or_else(|| {
+            SessionError::invalid(index, format!("line 1: no column \"{name}\" in the header"))
+        })
     };
+    Ok([
+        col("rep")?,
+        col("gesture_id")?,
+        col("start_sample")?,
+        col("end_sample_exclusive")?,
+    ])
+}
+
+fn three_dc_meta(dir: &Path, split: Split) -> Result<(SessionMeta, PathBuf), SessionError> {
+    let who = three_dc_participant(dir, split)?;
+    let npy = dir.join(format!("{who}_{}_emg.npy", split.name()));
+    let index = dir.join(format!("{who}_{}_index.csv", split.name()));
+    let text = read_text(&index)?;
+    let mut lines = text.lines().enumerate();
+    let header = lines.next().map(|(_, h)| h).unwrap_or("");
+    let [c_rep, c_gesture, c_start, c_end] = index_columns(header, &index)?;
     let us = |s: u64| s * 1000;
     let mut trials = Vec::new();
     let mut segments = Vec::new();
@@ -162,7 +203,7 @@ fn three_dc_meta(dir: &Path, split: Split) -> Result<(SessionMeta, PathBuf), Ses
         });
     }
     let meta = SessionMeta {
-        chain,
+        chain: three_dc_chain(),
         onset_skip_ms: THREE_DC_ONSET_SKIP_MS,
         recording: RecordingSpec {
             format: RecordingFormat::Npy,

@@ -26,6 +26,9 @@ pub enum Command {
     Import3dc(Import3dcArgs),
     /// Run the quality gates on a session and say which trials to redo.
     Check(CheckArgs),
+    /// Check that a model's every finger follows the effort monotonically along each
+    /// calibration window's effort ray (exact for ResDD and LN, sampled for MLP and CNN).
+    Verify(VerifyArgs),
     /// Write a session directory from an external recording: samples (NPY or CSV) plus a
     /// label table CSV with the header finger,kind,repetition,start_sample,end_sample.
     Import(ImportArgs),
@@ -144,6 +147,29 @@ pub struct TrainArgs {
     pub training: TrainingOpts,
 }
 
+/// `handctl verify`.
+#[derive(Debug, Args)]
+pub struct VerifyArgs {
+    /// Model file to verify.
+    #[arg(long)]
+    pub model: PathBuf,
+    /// Session whose flexion and extension windows give the rays: a directory, or
+    /// 3dc:DIR:train|test.
+    pub session: String,
+    /// Reversals up to this, in label units (full effort is 1), are accepted.
+    #[arg(long, default_value_t = decoder::model::verify::DEFAULT_TOLERANCE, value_parser = parse_tolerance)]
+    pub tolerance: f64,
+}
+
+fn parse_tolerance(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{v}: must be finite and >= 0"))
+    }
+}
+
 /// `handctl eval`.
 #[derive(Debug, Args)]
 pub struct EvalArgs {
@@ -166,7 +192,8 @@ pub struct EvalArgs {
 /// `handctl import-3dc`.
 #[derive(Debug, Args)]
 pub struct Import3dcArgs {
-    /// Directory holding P4_{train,test}_emg.npy and P4_{train,test}_index.csv.
+    /// Directory holding one participant's P<n>_{train,test}_emg.npy and
+    /// P<n>_{train,test}_index.csv (P4, P6, P7, ...).
     pub dir: PathBuf,
     /// Which half of the recordings.
     #[arg(long, value_parser = ["train", "test"])]

@@ -58,6 +58,12 @@ pub enum CliError {
     /// The quality gates found trials to redo.
     #[error("the session failed its quality gates ({0} trial problem(s) above); redo those trials, or pass --ignore-gates")]
     Gates(usize),
+    /// A verification could not run.
+    #[error("verification: {0}")]
+    Verify(#[from] decoder::model::verify::VerifyError),
+    /// Effort rays on which a finger goes back against the effort.
+    #[error("{0} effort ray(s) reverse beyond the tolerance (listed above)")]
+    Reversals(usize),
     /// The command cannot do what was asked with this data.
     #[error("{0}")]
     Usage(String),

@@ -15,6 +15,7 @@ mod import;
 mod progress;
 mod record;
 mod train;
+mod verify;
 
 use std::process::ExitCode;
 
@@ -31,6 +32,7 @@ pub fn run() -> ExitCode {
         Command::Eval(a) => eval::run(a),
         Command::Import3dc(a) => import::run_3dc(a),
         Command::Check(a) => train::run_check(a),
+        Command::Verify(a) => verify::run(a),
         Command::Import(a) => import::run_table(a),
         Command::Status(a) => daemon::status(&a.daemon, a.json),
         Command::Tune(a) => daemon::tune(a),

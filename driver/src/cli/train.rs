@@ -82,6 +82,11 @@ pub fn run(a: &TrainArgs) -> Result<(), CliError> {
     let model = fit(a.model, &data, &a.training)?;
     model.save(&a.output)?;
     println!("{}", describe(&model));
+    let tolerance = decoder::model::verify::DEFAULT_TOLERANCE;
+    println!(
+        "{}",
+        super::verify::after_training(&model, &session, &windows, tolerance)?
+    );
     println!("wrote {}", a.output.display());
     Ok(())
 }

@@ -1,0 +1,245 @@
+//! The exact effort-ray verifier (issue 12): it finds a reversal the 21-point metric misses,
+//! calls linear models monotonic, its polynomials are the model, and it never reports less than
+//! any sampling.
+
+use decoder::dsp::{ChainConfig, FEATURES_PER_CHANNEL};
+use decoder::eval::{judge_curve, InterpolationConfig};
+use decoder::model::verify::{
+    eval_polynomial, verify_windows, Method, RayCurves, RayVerifier, DEFAULT_TOLERANCE,
+};
+use decoder::model::{
+    AnyModel, Model, ModelKind, ModelSpec, Normalizer, ResDdSpec, ResDdVariant, Trainable,
+    TrainedModel, TrainingSummary, N_FINGERS,
+};
+use decoder::session::{LabelledWindows, Trial, TrialKind, WindowLabel};
+use proptest::prelude::*;
+use proptest::test_runner::RngSeed;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+fn bundle(model: AnyModel, spec: ModelSpec, normalizer: Normalizer) -> TrainedModel {
+    let channels = Model::n_inputs(&model) / FEATURES_PER_CHANNEL;
+    let chain = ChainConfig {
+        channels,
+        ..ChainConfig::default()
+    };
+    let kind = Model::kind(&model);
+    TrainedModel::new(
+        model,
+        spec,
+        normalizer,
+        chain,
+        TrainingSummary::untrained(kind),
+    )
+    .unwrap()
+}
+
+fn resdd_spec(hidden: usize, modules: usize, variant: ResDdVariant) -> ModelSpec {
+    ModelSpec {
+        resdd: ResDdSpec {
+            hidden,
+            modules,
+            variant,
+        },
+        ..ModelSpec::default()
+    }
+}
+
+/// One channel, H = 2, one module. With RMS = VAR = 1, `X = (k, k²)` and every finger's output
+/// is `S·[((k-m)³ + m³)/3 - r²k]`, whose slope `S·((k-m)² - r²)` is negative only on
+/// `(m - r, m + r) = (0.515, 0.535)`, strictly between the samples 0.5 and 0.55; over that
+/// dip the output falls by `4Sr³/3 = 0.02`, twice the tolerance, yet every 0.05 step rises.
+fn dipping_resdd() -> (TrainedModel, Vec<f64>) {
+    let (s, m, r) = (15_000.0, 0.525, 0.01);
+    let (c1, c2, c3) = (s * (m * m - r * r), -s * m, s / 3.0);
+    let q = (c2 + c3 - c1) / 2.0;
+    let (p, v) = (c2 - q, c3 - q);
+    let mut w_in = vec![0.0; 2 * 8];
+    w_in[0] = 1.0; // X1 = RMS
+    w_in[8 + 2] = 1.0; // X2 = VAR
+    let w_mod = vec![p, q, 1.0, 0.0];
+    let w_out: Vec<f64> = (0..N_FINGERS).flat_map(|_| [1.0, v]).collect();
+    let params = [w_in, w_mod, w_out].concat();
+    let spec = resdd_spec(2, 1, ResDdVariant::InputGated);
+    let model = AnyModel::from_params(ModelKind::ResDd, &spec, 8, N_FINGERS, params).unwrap();
+    let mut features = vec![0.0; 8];
+    features[0] = 1.0;
+    features[2] = 1.0;
+    (bundle(model, spec, Normalizer::identity(8)), features)
+}
+
+#[test]
+fn a_dip_between_samples_is_missed_by_21_points_and_found_exactly() {
+    let (model, features) = dipping_resdd();
+    let mut v = RayVerifier::exact(&model).unwrap();
+    let levels = InterpolationConfig::default().levels().unwrap();
+    let outputs: Vec<f64> = levels
+        .iter()
+        .map(|&k| v.output_at(&features, k)[0])
+        .collect();
+    let judged = judge_curve(0, 1.0, &levels, outputs, DEFAULT_TOLERANCE).unwrap();
+    assert!(
+        !judged.failed && judged.correct,
+        "the 21-point metric: {judged:?}"
+    );
+    let r = v.curves(&features).reversal(0, 1.0);
+    assert_eq!(r.method, Method::Exact);
+    assert!((r.amount - 0.02).abs() < 1e-9, "{r:?}");
+    assert!(
+        (r.from_k - 0.515).abs() < 1e-9 && (r.to_k - 0.535).abs() < 1e-9,
+        "{r:?}"
+    );
+    assert!(r.bound < 1e-12, "{r:?}");
+
+    let windows = LabelledWindows {
+        n_features: 8,
+        features: features.clone(),
+        labels: vec![WindowLabel {
+            trial: 0,
+            targets: [1.0; N_FINGERS],
+            mask: [true; N_FINGERS],
+            end_sample: 0,
+        }],
+    };
+    let trials = [Trial {
+        id: 7,
+        finger: None,
+        kind: TrialKind::Flexion,
+        repetition: 2,
+        start_us: 0,
+        end_us: 1,
+    }];
+    let report = verify_windows(&mut v, &windows, &trials, DEFAULT_TOLERANCE).unwrap();
+    assert_eq!((report.rays(), report.reversing()), (5, 5));
+    assert_eq!(
+        (report.sampled_failed(), report.sampled_not_correct()),
+        (0, 0)
+    );
+    assert!(!report.passed());
+    let text = report.to_string();
+    assert!(
+        text.contains("REVERSES trial 7 (all flexion, repetition 2) thumb"),
+        "{text}"
+    );
+}
+
+fn random_features(rng: &mut ChaCha8Rng, n: usize, var_zero: bool) -> Vec<f64> {
+    (0..n)
+        .map(|j| {
+            if var_zero && j % FEATURES_PER_CHANNEL == 2 {
+                0.0
+            } else {
+                rng.gen_range(0.0..3.0)
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn linear_models_never_reverse() {
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    let n_in = 3 * FEATURES_PER_CHANNEL;
+    let spec = resdd_spec(16, 0, ResDdVariant::InputGated);
+    let mut ln = AnyModel::random(ModelKind::Ln, &spec, n_in, N_FINGERS, 5).unwrap();
+    // No VAR weights: the LN is linear in k on every ray.
+    let hidden = spec.ln.hidden[0];
+    let w1 = &mut ln.params_mut()[..hidden * n_in];
+    for (j, w) in w1.iter_mut().enumerate() {
+        if j % n_in % FEATURES_PER_CHANNEL == 2 {
+            *w = 0.0;
+        }
+    }
+    let resdd0 = AnyModel::random(ModelKind::ResDd, &spec, n_in, N_FINGERS, 6).unwrap();
+    let scales: Vec<f64> = (0..n_in).map(|_| rng.gen_range(0.1..2.0)).collect();
+    for (model, var_zero) in [(ln, false), (resdd0, true)] {
+        let model = bundle(
+            model,
+            spec,
+            Normalizer::from_scales(scales.clone()).unwrap(),
+        );
+        let mut v = RayVerifier::exact(&model).unwrap();
+        for _ in 0..200 {
+            let f = random_features(&mut rng, n_in, var_zero);
+            let c = v.curves(&f);
+            for finger in 0..N_FINGERS {
+                let end = c.value(finger, 1.0);
+                let dir = if end >= 0.0 { 1.0 } else { -1.0 };
+                let with = c.reversal(finger, dir);
+                assert!(with.amount <= 1e-12, "{with:?}");
+                let against = c.reversal(finger, -dir);
+                assert!((against.amount - end.abs()).abs() <= 1e-12 * end.abs().max(1.0));
+            }
+        }
+    }
+}
+
+#[test]
+fn the_polynomials_are_the_model() {
+    let mut rng = ChaCha8Rng::seed_from_u64(3);
+    let n_in = 10 * FEATURES_PER_CHANNEL;
+    for (kind, variant) in [
+        (ModelKind::ResDd, ResDdVariant::InputGated),
+        (ModelKind::ResDd, ResDdVariant::Chained),
+        (ModelKind::Ln, ResDdVariant::InputGated),
+    ] {
+        let spec = resdd_spec(96, 2, variant);
+        let model = AnyModel::random(kind, &spec, n_in, N_FINGERS, 9).unwrap();
+        let scales: Vec<f64> = (0..n_in).map(|_| rng.gen_range(0.1..2.0)).collect();
+        let model = bundle(model, spec, Normalizer::from_scales(scales).unwrap());
+        let mut v = RayVerifier::exact(&model).unwrap();
+        for _ in 0..20 {
+            let f = random_features(&mut rng, n_in, false);
+            let RayCurves::Polynomials(p) = v.curves(&f) else {
+                panic!("a {kind} model verifies exactly");
+            };
+            for _ in 0..10 {
+                let k: f64 = rng.gen_range(0.0..=1.0);
+                let y = v.output_at(&f, k);
+                for (finger, yf) in y.iter().enumerate() {
+                    let e = eval_polynomial(&p[finger], k);
+                    assert!(
+                        (e - yf).abs() <= 1e-9 * yf.abs().max(1.0),
+                        "{kind} {variant:?} k {k}: polynomial {e}, forward {yf}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 300,
+        rng_seed: RngSeed::Fixed(12),
+        failure_persistence: None,
+        ..ProptestConfig::default()
+    })]
+
+    #[test]
+    fn exact_is_never_below_dense_sampling(
+        seed in any::<u64>(),
+        chained in any::<bool>(),
+        features in proptest::collection::vec(0.0f64..3.0, 8),
+        dir in prop_oneof![Just(1.0f64), Just(-1.0f64)],
+        finger in 0..N_FINGERS,
+    ) {
+        let variant = if chained { ResDdVariant::Chained } else { ResDdVariant::InputGated };
+        let spec = resdd_spec(4, 2, variant);
+        let model = AnyModel::random(ModelKind::ResDd, &spec, 8, N_FINGERS, seed).unwrap();
+        let model = bundle(model, spec, Normalizer::identity(8));
+        let mut v = RayVerifier::exact(&model).unwrap();
+        let exact = v.curves(&features).reversal(finger, dir);
+        let n = 2001;
+        let mut peak = f64::NEG_INFINITY;
+        let mut sampled: f64 = 0.0;
+        let mut scale: f64 = 1.0;
+        for i in 0..n {
+            let z = dir * v.output_at(&features, i as f64 / (n - 1) as f64)[finger];
+            peak = peak.max(z);
+            sampled = sampled.max(peak - z);
+            scale = scale.max(z.abs());
+        }
+        prop_assert!(exact.amount >= sampled - 1e-12 * scale, "exact {exact:?}, sampled {sampled}");
+        prop_assert!(exact.bound <= 1e-12 * scale, "{exact:?}");
+    }
+}
