@@ -11,7 +11,7 @@
 use std::path::{Path, PathBuf};
 
 use decoder::dsp::npy::read_npy;
-use decoder::dsp::ChainConfig;
+use decoder::dsp::{ChainConfig, FEATURES_PER_CHANNEL};
 use decoder::model::{AnyModel, ModelKind, ModelSpec, Normalizer, TrainedModel, TrainingSummary};
 use decoder::session::{
     RecordingFormat, RecordingSpec, Session, SessionMeta, Trial, TrialKind, WindowOptions,
@@ -20,6 +20,7 @@ use driver::engine::{Engine, EngineSettings};
 use hand_dbc::candump::{read_log, LogWriter};
 use hand_dbc::e2e::E2eProtector;
 use hand_dbc::emg::{EMG_CHANNELS, EMG_LSB_UV};
+use hand_dbc::hand::N_FINGERS;
 use hand_dbc::messages::{EmgSamplesG0, EmgSamplesG1, EmgSamplesG2};
 use hand_dbc::CanFrame;
 use hand_model::emg::AmplifierConfig;
@@ -48,9 +49,9 @@ fn temp_dir(name: &str) -> PathBuf {
 
 /// A deterministic model (random weights, fixed seed) for `chain`.
 fn model(chain: &ChainConfig) -> TrainedModel {
-    let n_in = 8 * chain.channels;
+    let n_in = FEATURES_PER_CHANNEL * chain.channels;
     let spec = ModelSpec::default();
-    let net = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, 7).expect("model");
+    let net = AnyModel::random(ModelKind::ResDd, &spec, n_in, N_FINGERS, 7).expect("model");
     let norm = Normalizer::from_scales(vec![20.0; n_in]).expect("scales");
     let summary = TrainingSummary::untrained(ModelKind::ResDd);
     TrainedModel::new(net, spec, norm, chain.clone(), summary).expect("model")
