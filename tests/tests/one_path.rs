@@ -13,14 +13,12 @@ use std::path::{Path, PathBuf};
 use decoder::dsp::npy::read_npy;
 use decoder::dsp::{ChainConfig, FEATURES_PER_CHANNEL};
 use decoder::model::{AnyModel, ModelKind, ModelSpec, Normalizer, TrainedModel, TrainingSummary};
-use decoder::session::{
-    RecordingFormat, RecordingSpec, Session, SessionMeta, Trial, TrialKind, WindowOptions,
-};
+use decoder::session::{Session, SessionMeta, Trial, TrialKind, WindowOptions};
 use driver::engine::{Engine, EngineSettings};
 use hand_dbc::candump::{read_log, LogWriter};
 use hand_dbc::e2e::E2eProtector;
 use hand_dbc::emg::{EMG_CHANNELS, EMG_LSB_UV};
-use hand_dbc::hand::N_FINGERS;
+use hand_dbc::hand::{ADC_MAX, N_FINGERS};
 use hand_dbc::messages::{EmgSamplesG0, EmgSamplesG1, EmgSamplesG2};
 use hand_dbc::CanFrame;
 use hand_model::emg::AmplifierConfig;
@@ -117,24 +115,20 @@ fn write_three_dc_session(dir: &Path) {
         }
     }
     std::fs::write(dir.join("frames.log"), log.into_inner()).expect("write log");
-    let meta = SessionMeta {
-        chain: ChainConfig::default(),
-        onset_skip_ms: 0.0,
-        recording: RecordingSpec {
-            format: RecordingFormat::Candump,
-            file: PathBuf::from("frames.log"),
-            full_scale: Some(2047.0),
-        },
-        segments: Vec::new(),
-        trials: vec![Trial {
-            id: 1,
-            finger: None,
-            kind: TrialKind::Rest,
-            repetition: 1,
-            start_us: 0,
-            end_us: T0_US + n as u64 * 1000 + 1000,
-        }],
+    let rest = Trial {
+        id: 1,
+        finger: None,
+        kind: TrialKind::Rest,
+        repetition: 1,
+        start_us: 0,
+        end_us: T0_US + n as u64 * 1000 + 1000,
     };
+    let meta = SessionMeta::candump(
+        ChainConfig::default(),
+        "frames.log",
+        f64::from(ADC_MAX),
+        vec![rest],
+    );
     meta.write(dir).expect("session.toml");
 }
 
