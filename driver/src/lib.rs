@@ -1,11 +1,10 @@
 //! The product: the `handd` daemon (the 50 ms control loop, its safety state machine and
-//! transports) and the technician CLI `handctl` ([`cli`]).
+//! transports, the control socket). The technician's CLI `handctl` is its own crate
+//! (`handctl/`), a client of this one.
 //!
 //! Features (none by default, which is the daemon's build): `sim` adds the demo and the
-//! in-memory transport on the simulator (`hand-model`); `plots` lets `handctl eval` draw PNG
-//! figures (the plotting stack). `handd` needs neither and links neither.
+//! in-memory transport on the simulator (`hand-model`). `handd` neither needs nor links it.
 
-pub mod cli;
 pub mod conditioner;
 pub mod config;
 pub mod control;

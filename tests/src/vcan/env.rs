@@ -40,7 +40,7 @@ impl VcanEnv {
             assert!(
                 bin_dir.join(b).is_file(),
                 "vcan suite: {} is missing: build the binaries into the same profile \
-                 (cargo build --release -p driver -p hand-model --bins) or set HANDSTACK_BIN_DIR",
+                 (cargo build --release -p driver -p handctl -p hand-model --bins) or set HANDSTACK_BIN_DIR",
                 bin_dir.join(b).display()
             );
         }

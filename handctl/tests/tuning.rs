@@ -4,6 +4,8 @@
 //! change, and `handctl status` shows it. A bad value is refused with the range and changes
 //! nothing.
 
+// The in-memory rig of driver's own loop tests, shared rather than copied.
+#[path = "../../driver/tests/common/mod.rs"]
 mod common;
 
 use std::process::{Command, Stdio};

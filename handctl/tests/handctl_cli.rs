@@ -299,7 +299,7 @@ fn the_demo_says_how_to_build_it_and_socket_failures_are_not_usage_errors() {
         assert_eq!(out.status.code(), Some(1));
         let e = text(&out.stderr);
         assert!(
-            e.contains("cargo run --release --features sim --bin handctl -- demo"),
+            e.contains("cargo run --release -p handctl --features sim -- demo"),
             "{e}"
         );
     }

@@ -1,5 +1,9 @@
-//! `handctl`, the technician's command line: one module per subcommand, the argument
-//! structures in `args`; `bin/handctl.rs` calls [`run`].
+//! `handctl`, the technician's command line for the hand: calibration training, evaluation,
+//! importing recordings, the running daemon's status, live tuning, arm and stop, and the demo
+//! (with the `sim` feature). One module per subcommand, the argument structures in `args`.
+//!
+//! A crate of its own, beside the daemon's (`driver`): what only the technician's tool needs
+//! (the terminal UI, plotting) never enters `handd`'s build.
 //!
 //! `handctl demo` always parses; it runs only in a build with the `sim` feature (the
 //! simulator), and otherwise fails saying how to build it. `handctl eval --plots` draws PNG
@@ -25,7 +29,7 @@ use args::{Cli, Command};
 
 /// Parses the command line, runs the command, prints an error and returns the exit code
 /// (0 success, 1 failure, 2 usage error from clap, 3 quality gates refused the session).
-pub fn run() -> ExitCode {
+fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Train(a) => train::run(a),
@@ -51,7 +55,8 @@ pub fn run() -> ExitCode {
 }
 
 /// How to build a handctl with the demo.
-pub const DEMO_BUILD: &str = "cargo run --release --features sim --bin handctl -- demo";
+#[cfg(not(feature = "sim"))]
+const DEMO_BUILD: &str = "cargo run --release -p handctl --features sim -- demo";
 
 #[cfg(feature = "sim")]
 fn run_demo(a: &args::DemoArgs) -> Result<(), error::CliError> {

@@ -26,13 +26,13 @@ pub enum CliError {
     /// handd's control socket could not be reached, or answered badly (the io::Error, if any,
     /// is the source).
     #[error(transparent)]
-    Control(#[from] crate::control::ControlError),
+    Control(#[from] driver::control::ControlError),
     /// The configuration that names handd's socket could not be read.
     #[error("cannot find handd's socket: {0}")]
-    Config(#[from] crate::config::ConfigError),
+    Config(#[from] driver::config::ConfigError),
     /// The CAN interface is down or missing.
     #[error(transparent)]
-    Bus(#[from] crate::transport::TransportError),
+    Bus(#[from] driver::transport::TransportError),
     /// A CAN socket could not be opened, set up or read.
     #[error("CAN interface {iface:?}: {what}: {source}")]
     Can {
@@ -82,7 +82,7 @@ impl CliError {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::control::ControlError;
+    use driver::control::ControlError;
 
     #[test]
     fn socket_failures_keep_the_os_error_as_their_source() {

@@ -3,10 +3,10 @@
 
 use std::path::PathBuf;
 
-use crate::config::{Config, DEFAULT_CONFIG_PATH};
-use crate::control::{request, ControlError};
-use crate::protocol::{Reply, Request, Status};
-use crate::units::FINGER_NAMES;
+use driver::config::{Config, DEFAULT_CONFIG_PATH};
+use driver::control::{request, ControlError};
+use driver::protocol::{Reply, Request, Status};
+use driver::units::FINGER_NAMES;
 
 use super::args::{DaemonOpts, TuneArgs};
 use super::error::CliError;

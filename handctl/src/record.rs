@@ -28,7 +28,7 @@ use socketcan::{CanSocket, EmbeddedFrame, Socket, SocketOptions};
 
 use super::args::RecordArgs;
 use super::error::CliError;
-use crate::units::ADC_MAX;
+use driver::units::ADC_MAX;
 
 /// EMG_SAMPLES_G0's id (hand.dbc): the frame that carries the sample counter first.
 const EMG_G0_ID: u32 = 0x100;
@@ -95,7 +95,7 @@ pub fn run(a: &RecordArgs) -> Result<(), CliError> {
 }
 
 fn open(iface: &str) -> Result<CanSocket, CliError> {
-    crate::socketcan_bus::interface_up(iface)?;
+    driver::socketcan_bus::interface_up(iface)?;
     let bad = |source| CliError::Can {
         iface: iface.to_owned(),
         what: "cannot open it".into(),

@@ -1,11 +1,11 @@
 //! `handctl demo`: the whole system in one process over the in-memory bus (see
-//! `crate::demo`), with live per-finger state on the terminal and the tracking scores at the
+//! `driver::demo`), with live per-finger state on the terminal and the tracking scores at the
 //! end.
 
 use std::io::{IsTerminal, Write};
 
-use crate::demo::{run_demo, DemoEvent, DemoOptions};
-use crate::units::FINGER_NAMES;
+use driver::demo::{run_demo, DemoEvent, DemoOptions};
+use driver::units::FINGER_NAMES;
 
 use super::args::DemoArgs;
 use super::error::CliError;
