@@ -5,6 +5,7 @@
 //! in-memory transport on the simulator (`hand-model`); `plots` lets `handctl eval` draw PNG
 //! figures (the plotting stack). `handd` needs neither and links neither.
 
+pub mod bus_load;
 pub mod cli;
 pub mod conditioner;
 pub mod config;
@@ -13,6 +14,7 @@ pub mod daemon;
 #[cfg(feature = "sim")]
 pub mod demo;
 pub mod engine;
+pub mod live;
 #[cfg(feature = "sim")]
 pub mod mem_transport;
 pub mod protocol;
