@@ -137,7 +137,36 @@ pub fn parse_request_bytes(line: &[u8]) -> Result<Request, String> {
     }
     let line = std::str::from_utf8(line)
         .map_err(|e| format!("malformed request: not UTF-8 text ({e})"))?;
-    serde_json::from_str(line.trim()).map_err(|e| format!("malformed request: {e}"))
+    let malformed = |e: serde_json::Error| format!("malformed request: {e}");
+    let value: serde_json::Value = serde_json::from_str(line.trim()).map_err(malformed)?;
+    let req: Request = Request::deserialize(&value).map_err(malformed)?;
+    // serde ignores unknown fields beside the tag of a variant without fields: check them all.
+    let allowed = req.fields();
+    if let Some(extra) = value
+        .as_object()
+        .and_then(|o| o.keys().find(|k| k.as_str() != "cmd" && !allowed.contains(&k.as_str())))
+    {
+        return Err(format!(
+            "malformed request: unknown field `{extra}` (this command takes {})",
+            if allowed.is_empty() {
+                "none".to_owned()
+            } else {
+                allowed.join(", ")
+            }
+        ));
+    }
+    Ok(req)
+}
+
+impl Request {
+    /// The fields this command takes besides `cmd`.
+    fn fields(&self) -> &'static [&'static str] {
+        match self {
+            Request::Status | Request::Arm | Request::Stop => &[],
+            Request::Tune { .. } => &["finger", "kf", "kalpha"],
+            Request::Subscribe { .. } => &["every_ms"],
+        }
+    }
 }
 
 #[cfg(test)]
@@ -201,6 +230,15 @@ mod tests {
         assert!(parse_request(&"x".repeat(5000))
             .unwrap_err()
             .contains("longer"));
+        for (line, field) in [
+            (r#"{"cmd":"status","extra":1}"#, "extra"),
+            (r#"{"cmd":"stop","force":true}"#, "force"),
+            (r#"{"cmd":"tune","finger":"index","kff":1}"#, "kff"),
+            (r#"{"cmd":"subscribe","every":100}"#, "every"),
+        ] {
+            let e = parse_request(line).unwrap_err();
+            assert!(e.contains(&format!("unknown field `{field}`")), "{line}: {e}");
+        }
         assert!(parse_request_bytes(b"{\"cmd\":\"st\xffatus\"}")
             .unwrap_err()
             .contains("UTF-8"));

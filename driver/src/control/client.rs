@@ -22,7 +22,13 @@ fn connect(path: &Path, req: &Request) -> Result<UnixStream, ControlError> {
     stream.set_read_timeout(Some(REPLY_WAIT)).map_err(err)?;
     let mut line = serde_json::to_string(req).map_err(|e| ControlError::BadReply(e.to_string()))?;
     line.push('\n');
-    stream.write_all(line.as_bytes()).map_err(err)?;
+    if let Err(e) = stream.write_all(line.as_bytes()) {
+        // The daemon may have refused the connection (not in the group, too many open) and
+        // closed it before the request went out: its reason is still there to read.
+        if e.kind() != std::io::ErrorKind::BrokenPipe {
+            return Err(err(e));
+        }
+    }
     Ok(stream)
 }
 

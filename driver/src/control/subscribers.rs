@@ -103,12 +103,6 @@ impl Hub {
         subs.retain(|s| s.id != id);
     }
 
-    /// Number of subscribers now.
-    #[cfg(test)]
-    pub(super) fn len(&self) -> usize {
-        self.subs.lock().unwrap_or_else(|e| e.into_inner()).len()
-    }
-
     /// Polls the snapshot twice per tick, forever, and publishes each new tick.
     pub(super) fn publish_forever(&self) {
         let mut last_tick = u64::MAX;
