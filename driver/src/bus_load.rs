@@ -83,14 +83,14 @@ mod tests {
             b.close_tick();
         }
         assert!((b.load() - 100.0 * 135.0 * 20.0 / 1e6).abs() < 1e-12, "{}", b.load());
-        // A second of two-byte frames replaces it (85 bits each).
+        // A second of two-byte frames replaces it (47 + 16 + 49/4 = 75 bits each).
         for _ in 0..20 {
             for _ in 0..10 {
                 b.frame(&f2);
             }
             b.close_tick();
         }
-        assert!((b.load() - 10.0 * 85.0 * 20.0 / 1e6).abs() < 1e-12, "{}", b.load());
+        assert!((b.load() - 10.0 * 75.0 * 20.0 / 1e6).abs() < 1e-12, "{}", b.load());
         // Half a second counts over half a second.
         let mut h = BusLoad::new(50_000);
         for _ in 0..10 {
