@@ -82,7 +82,11 @@ mod tests {
             }
             b.close_tick();
         }
-        assert!((b.load() - 100.0 * 135.0 * 20.0 / 1e6).abs() < 1e-12, "{}", b.load());
+        assert!(
+            (b.load() - 100.0 * 135.0 * 20.0 / 1e6).abs() < 1e-12,
+            "{}",
+            b.load()
+        );
         // A second of two-byte frames replaces it (47 + 16 + 49/4 = 75 bits each).
         for _ in 0..20 {
             for _ in 0..10 {
@@ -90,13 +94,21 @@ mod tests {
             }
             b.close_tick();
         }
-        assert!((b.load() - 10.0 * 75.0 * 20.0 / 1e6).abs() < 1e-12, "{}", b.load());
+        assert!(
+            (b.load() - 10.0 * 75.0 * 20.0 / 1e6).abs() < 1e-12,
+            "{}",
+            b.load()
+        );
         // Half a second counts over half a second.
         let mut h = BusLoad::new(50_000);
         for _ in 0..10 {
             h.frame(&f8);
             h.close_tick();
         }
-        assert!((h.load() - 135.0 * 20.0 / 1e6).abs() < 1e-12, "{}", h.load());
+        assert!(
+            (h.load() - 135.0 * 20.0 / 1e6).abs() < 1e-12,
+            "{}",
+            h.load()
+        );
     }
 }

@@ -142,10 +142,10 @@ pub fn parse_request_bytes(line: &[u8]) -> Result<Request, String> {
     let req: Request = Request::deserialize(&value).map_err(malformed)?;
     // serde ignores unknown fields beside the tag of a variant without fields: check them all.
     let allowed = req.fields();
-    if let Some(extra) = value
-        .as_object()
-        .and_then(|o| o.keys().find(|k| k.as_str() != "cmd" && !allowed.contains(&k.as_str())))
-    {
+    if let Some(extra) = value.as_object().and_then(|o| {
+        o.keys()
+            .find(|k| k.as_str() != "cmd" && !allowed.contains(&k.as_str()))
+    }) {
         return Err(format!(
             "malformed request: unknown field `{extra}` (this command takes {})",
             if allowed.is_empty() {
@@ -215,7 +215,10 @@ mod tests {
         assert_eq!(subscribe_ticks(Some(60_000), 50), Ok(1200));
         for bad in [0, 49, 60_001] {
             let e = subscribe_ticks(Some(bad), 50).unwrap_err();
-            assert!(e.contains(&bad.to_string()) && e.contains("50 (one tick)"), "{e}");
+            assert!(
+                e.contains(&bad.to_string()) && e.contains("50 (one tick)"),
+                "{e}"
+            );
         }
         assert!(parse_request(r#"{"cmd":"subscribe","every_ms":-5}"#).is_err());
     }
@@ -237,7 +240,10 @@ mod tests {
             (r#"{"cmd":"subscribe","every":100}"#, "every"),
         ] {
             let e = parse_request(line).unwrap_err();
-            assert!(e.contains(&format!("unknown field `{field}`")), "{line}: {e}");
+            assert!(
+                e.contains(&format!("unknown field `{field}`")),
+                "{line}: {e}"
+            );
         }
         assert!(parse_request_bytes(b"{\"cmd\":\"st\xffatus\"}")
             .unwrap_err()

@@ -68,7 +68,9 @@ impl Daemon {
         config.save_atomic(&config_path).expect("config saved");
 
         let clock = SystemClock::new();
-        let chain = decoder::dsp::ChainConfig::default().validate().expect("chain");
+        let chain = decoder::dsp::ChainConfig::default()
+            .validate()
+            .expect("chain");
         let settings = EngineSettings {
             deadline_slack_us: SLACK_US,
             ..EngineSettings::default()
@@ -131,7 +133,9 @@ impl Daemon {
 fn reply_on(s: &UnixStream, wait: Duration) -> Reply {
     s.set_read_timeout(Some(wait)).expect("timeout");
     let mut line = String::new();
-    BufReader::new(s).read_line(&mut line).expect("a reply line");
+    BufReader::new(s)
+        .read_line(&mut line)
+        .expect("a reply line");
     serde_json::from_str(line.trim()).unwrap_or_else(|e| panic!("{e}: {line:?}"))
 }
 
@@ -169,10 +173,19 @@ fn silent_clients_do_not_delay_status_or_the_tick() {
     let silent: Vec<UnixStream> = (0..100).map(|_| d.connect()).collect();
     let (took, reply) = timed_status(&d);
     assert!(
-        matches!(reply, Reply::Ok { status: Some(_), .. }),
+        matches!(
+            reply,
+            Reply::Ok {
+                status: Some(_),
+                ..
+            }
+        ),
         "{reply:?}"
     );
-    assert!(took < Duration::from_secs(1), "status took {took:?} with 100 silent clients");
+    assert!(
+        took < Duration::from_secs(1),
+        "status took {took:?} with 100 silent clients"
+    );
     // A silent client is told why it is dropped, after the request deadline.
     let reason = refusal(reply_on(&silent[0], Duration::from_secs(3)));
     assert!(reason.contains("no request within 1000 ms"), "{reason}");
@@ -190,7 +203,10 @@ fn silent_clients_do_not_delay_status_or_the_tick() {
     drop(silent);
     let snap = d.finish();
     assert_ticks_on_time(&snap, 20);
-    println!("status with 100 silent clients took {took:?}; lateness {:?}", snap.lateness);
+    println!(
+        "status with 100 silent clients took {took:?}; lateness {:?}",
+        snap.lateness
+    );
 }
 
 #[test]
@@ -259,7 +275,10 @@ fn oversize_malformed_and_incomplete_requests_are_refused_with_a_reason() {
         panic!("no status")
     };
     let default = Config::default();
-    assert_eq!(status.fingers[1].kf, default.fingers.index.kf, "kf unchanged");
+    assert_eq!(
+        status.fingers[1].kf, default.fingers.index.kf,
+        "kf unchanged"
+    );
     let snap = d.finish();
     assert_ticks_on_time(&snap, 5);
 }
@@ -273,8 +292,15 @@ fn connections_beyond_the_cap_are_refused_at_once_and_the_slots_come_back() {
     let extra = d.connect();
     let t = Instant::now();
     let reason = refusal(reply_on(&extra, Duration::from_secs(3)));
-    assert!(reason.contains("busy") && reason.contains("128"), "{reason}");
-    assert!(t.elapsed() < Duration::from_millis(900), "refused after {:?}", t.elapsed());
+    assert!(
+        reason.contains("busy") && reason.contains("128"),
+        "{reason}"
+    );
+    assert!(
+        t.elapsed() < Duration::from_millis(900),
+        "refused after {:?}",
+        t.elapsed()
+    );
     drop(held);
     // Closed connections free their slots as soon as their threads see the end.
     let mut answered = false;
@@ -322,11 +348,7 @@ fn a_user_outside_the_group_is_refused() {
     );
     std::thread::sleep(Duration::from_millis(150));
     let snap = d.finish();
-    assert_ne!(
-        snap.state,
-        driver::DaemonState::Boot,
-        "the loop ran"
-    );
+    assert_ne!(snap.state, driver::DaemonState::Boot, "the loop ran");
     assert!(
         !snap.faults.contains(driver::Fault::StopRequested),
         "the outsider's stop was applied"
@@ -335,7 +357,8 @@ fn a_user_outside_the_group_is_refused() {
 
 /// Reads lines from a subscription socket until `until`; the Live lines read.
 fn read_lines(s: UnixStream, until: Instant) -> Vec<Live> {
-    s.set_read_timeout(Some(Duration::from_secs(2))).expect("timeout");
+    s.set_read_timeout(Some(Duration::from_secs(2)))
+        .expect("timeout");
     let mut r = BufReader::new(s);
     let mut out = Vec::new();
     let mut line = String::new();
@@ -353,7 +376,8 @@ fn subscribe_raw(d: &Daemon, every_ms: u64) -> (UnixStream, Reply) {
     let mut s = d.connect();
     writeln!(s, "{{\"cmd\":\"subscribe\",\"every_ms\":{every_ms}}}").expect("sent");
     // The acknowledgement, read byte by byte so no Live line is taken with it.
-    s.set_read_timeout(Some(Duration::from_secs(3))).expect("timeout");
+    s.set_read_timeout(Some(Duration::from_secs(3)))
+        .expect("timeout");
     let mut line = Vec::new();
     let mut b = [0u8; 1];
     while line.last() != Some(&b'\n') {
@@ -419,11 +443,15 @@ fn stuck_subscribers_are_dropped_readers_keep_receiving_and_no_tick_is_late() {
         assert_eq!(last.fingers.len(), 5);
         assert_eq!(last.channels.len(), 12);
         assert_eq!(last.model.id, "0000beef");
-        assert!(last.counters.frames_tx > 0 && last.bus_load > 0.0, "{last:?}");
+        assert!(
+            last.counters.frames_tx > 0 && last.bus_load > 0.0,
+            "{last:?}"
+        );
     }
     // Each stuck subscriber was dropped: its socket ends (EOF) after the lines it holds.
     for (i, mut s) in stuck.into_iter().enumerate() {
-        s.set_read_timeout(Some(Duration::from_secs(2))).expect("timeout");
+        s.set_read_timeout(Some(Duration::from_secs(2)))
+            .expect("timeout");
         let mut rest = Vec::new();
         let r = s.read_to_end(&mut rest);
         assert!(r.is_ok(), "stuck subscriber {i} was not dropped: {r:?}");

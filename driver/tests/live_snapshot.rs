@@ -26,7 +26,9 @@ fn worst_case_bits(f: &CanFrame) -> u64 {
 #[test]
 fn a_live_line_matches_the_bus() {
     let mut script = Script::new();
-    script.rest(500_000).hold(Intent::finger(1, 0.6), 10_000_000);
+    script
+        .rest(500_000)
+        .hold(Intent::finger(1, 0.6), 10_000_000);
     let mut rig = Rig::new(FaultPlan::new(), script);
     rig.run_until(3_010_000);
     let snap = *rig.runner.snapshot().lock().expect("snapshot");
@@ -54,7 +56,11 @@ fn a_live_line_matches_the_bus() {
         .map(|(_, f)| worst_case_bits(f))
         .sum();
     let load = bits as f64 / 1e6;
-    assert!((live.bus_load - load).abs() < 1e-9, "{} vs {load}", live.bus_load);
+    assert!(
+        (live.bus_load - load).abs() < 1e-9,
+        "{} vs {load}",
+        live.bus_load
+    );
     println!("bus load over the last second: {:.3}", live.bus_load);
 
     for f in 0..5 {

@@ -39,7 +39,8 @@ impl AccessPolicy {
     /// Whether `peer` may use the socket, reading its supplementary groups from `/proc` only
     /// when its user and primary group do not settle it.
     pub fn admits(&self, peer: &Peer) -> bool {
-        self.allows(peer, &[]) || (self.group_gid.is_some() && self.allows(peer, &supplementary_groups(peer.pid)))
+        self.allows(peer, &[])
+            || (self.group_gid.is_some() && self.allows(peer, &supplementary_groups(peer.pid)))
     }
 }
 

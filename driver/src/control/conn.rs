@@ -89,7 +89,11 @@ pub(super) fn serve_connection(stream: UnixStream, peer: Peer, shared: &Shared) 
     let reply = match read_request(&stream) {
         None => return,
         Some(Err(reason)) => {
-            tracing::info!(uid = peer.uid, pid = peer.pid, "control request refused: {reason}");
+            tracing::info!(
+                uid = peer.uid,
+                pid = peer.pid,
+                "control request refused: {reason}"
+            );
             Reply::Refused { reason }
         }
         Some(Ok(Request::Subscribe { every_ms })) => {

@@ -71,5 +71,4 @@ mod tests {
         );
         fs::remove_dir_all(&dir).unwrap();
     }
-
 }

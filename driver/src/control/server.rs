@@ -72,7 +72,11 @@ pub(super) fn send_reply(mut stream: &UnixStream, reply: &Reply, timeout: Durati
 }
 
 fn refuse(stream: &UnixStream, reason: String) {
-    send_reply(stream, &Reply::Refused { reason }, Duration::from_millis(50));
+    send_reply(
+        stream,
+        &Reply::Refused { reason },
+        Duration::from_millis(50),
+    );
 }
 
 impl ControlServer {
@@ -198,7 +202,10 @@ fn admit(stream: UnixStream, policy: &AccessPolicy, shared: &Arc<Shared>) {
     if let Err(e) = started {
         tracing::warn!(error = %e, "control connection thread not started");
         if let Some(s) = refusal {
-            refuse(&s, "busy: handd could not start a thread for this connection".into());
+            refuse(
+                &s,
+                "busy: handd could not start a thread for this connection".into(),
+            );
         }
     }
 }

@@ -166,14 +166,30 @@ pub(super) fn serve_subscriber(
     let (every, (id, lines)) = match registered {
         Ok(r) => r,
         Err(reason) => {
-            tracing::info!(uid = peer.uid, pid = peer.pid, "subscription refused: {reason}");
+            tracing::info!(
+                uid = peer.uid,
+                pid = peer.pid,
+                "subscription refused: {reason}"
+            );
             return send_reply(&stream, &Reply::Refused { reason }, REPLY_TIMEOUT);
         }
     };
     let period_ms = every * hub.tick_ms();
-    tracing::info!(uid = peer.uid, pid = peer.pid, period_ms, "live subscriber added");
+    tracing::info!(
+        uid = peer.uid,
+        pid = peer.pid,
+        period_ms,
+        "live subscriber added"
+    );
     let message = format!("subscribed: one line every {period_ms} ms");
-    send_reply(&stream, &Reply::Ok { message, status: None }, REPLY_TIMEOUT);
+    send_reply(
+        &stream,
+        &Reply::Ok {
+            message,
+            status: None,
+        },
+        REPLY_TIMEOUT,
+    );
     let _ = rustix::net::sockopt::set_socket_send_buffer_size(&stream, LIVE_SEND_BUFFER);
     let _ = stream.set_write_timeout(Some(LIVE_WRITE_TIMEOUT));
     write_lines(&stream, &peer, &lines);
@@ -187,10 +203,11 @@ fn write_lines(mut stream: &UnixStream, peer: &Peer, lines: &Receiver<Arc<str>>)
     for line in lines {
         match stream.write_all(line.as_bytes()) {
             Ok(()) => {}
-            Err(e) if matches!(
-                e.kind(),
-                std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-            ) =>
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) =>
             {
                 tracing::warn!(
                     uid = peer.uid,

@@ -44,7 +44,11 @@ fn h_twenty_subscribers_ten_stuck_no_deadline_miss() {
 
     for (i, r) in readers.into_iter().enumerate() {
         let lines = r.join().expect("reader");
-        assert!(lines.len() >= 40, "reader {i}: {} lines in 4 s", lines.len());
+        assert!(
+            lines.len() >= 40,
+            "reader {i}: {} lines in 4 s",
+            lines.len()
+        );
         assert!(
             lines.windows(2).all(|w| w[1].tick > w[0].tick),
             "reader {i}: ticks go forward"
@@ -52,7 +56,11 @@ fn h_twenty_subscribers_ten_stuck_no_deadline_miss() {
         let last = lines.last().expect("a line");
         assert_eq!(last.state, "RUNNING", "reader {i}: {last:?}");
         assert!(last.counters.frames_rx > 0, "reader {i}: {last:?}");
-        assert!(last.bus_load > 0.0 && last.bus_load < 0.5, "{}", last.bus_load);
+        assert!(
+            last.bus_load > 0.0 && last.bus_load < 0.5,
+            "{}",
+            last.bus_load
+        );
         assert!(last.channels.iter().any(|c| c.rms_uv > 0.0), "{last:?}");
     }
     for (i, mut s) in stuck.into_iter().enumerate() {
@@ -64,7 +72,11 @@ fn h_twenty_subscribers_ten_stuck_no_deadline_miss() {
     }
     let st = rig.cfg.status(&rig.env);
     sim.wait_success(Duration::from_secs(60));
-    let dropped = rig.handd.output().matches("live subscriber dropped").count();
+    let dropped = rig
+        .handd
+        .output()
+        .matches("live subscriber dropped")
+        .count();
     let misses = st.deadline_misses - st0.deadline_misses;
     println!(
         "subscribers: {misses} deadline misses with 20 subscribers (10 stuck, {dropped} drop \
