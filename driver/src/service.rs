@@ -90,45 +90,7 @@ impl ControlHandler {
                 message: "status".into(),
                 status: Some(self.status()),
             },
-            Request::Tune { finger, kf, kalpha } => {
-                let change = match plan_tune(&self.config, &finger, kf, kalpha) {
-                    Ok(c) => c,
-                    Err(reason) => return Reply::Refused { reason },
-                };
-                let next = match commit_tune(&self.config, &change, &self.config_path, &user) {
-                    Ok(n) => n,
-                    Err(reason) => return Reply::Refused { reason },
-                };
-                if let Err(r) = self.send(Command::SetGains(change.finger, change.new.gains())) {
-                    // Nothing partly applied: the loop never saw it, so the file goes back.
-                    if let Err(e) = self.config.save_atomic(&self.config_path) {
-                        tracing::error!(error = %e, "tune: the config could not be restored");
-                    }
-                    return *r;
-                }
-                self.config = next;
-                tracing::info!(
-                    user,
-                    finger = FINGER_NAMES[change.finger],
-                    old_kf = change.old.kf,
-                    new_kf = change.new.kf,
-                    old_kalpha = change.old.kalpha,
-                    new_kalpha = change.new.kalpha,
-                    "tuned"
-                );
-                Reply::Ok {
-                    message: format!(
-                        "{}: kf {} -> {} N, kalpha {} -> {} rad/s²; takes effect at the next tick; saved to {}",
-                        FINGER_NAMES[change.finger],
-                        change.old.kf,
-                        change.new.kf,
-                        change.old.kalpha,
-                        change.new.kalpha,
-                        self.config_path.display()
-                    ),
-                    status: None,
-                }
-            }
+            Request::Tune { finger, kf, kalpha } => self.tune(&finger, kf, kalpha, &user),
             Request::Arm => match self.send(Command::Arm) {
                 Ok(()) => {
                     tracing::warn!(user, "armed by a technician");
@@ -152,6 +114,48 @@ impl ControlHandler {
                 }
                 Err(r) => *r,
             },
+        }
+    }
+
+    /// `tune`: checked completely, saved, then handed to the loop; refused with nothing
+    /// changed on any failure.
+    fn tune(&mut self, finger: &str, kf: Option<f64>, kalpha: Option<f64>, user: &str) -> Reply {
+        let change = match plan_tune(&self.config, finger, kf, kalpha) {
+            Ok(c) => c,
+            Err(reason) => return Reply::Refused { reason },
+        };
+        let next = match commit_tune(&self.config, &change, &self.config_path, user) {
+            Ok(n) => n,
+            Err(reason) => return Reply::Refused { reason },
+        };
+        if let Err(r) = self.send(Command::SetGains(change.finger, change.new.gains())) {
+            // Nothing partly applied: the loop never saw it, so the file goes back.
+            if let Err(e) = self.config.save_atomic(&self.config_path) {
+                tracing::error!(error = %e, "tune: the config could not be restored");
+            }
+            return *r;
+        }
+        self.config = next;
+        tracing::info!(
+            user,
+            finger = FINGER_NAMES[change.finger],
+            old_kf = change.old.kf,
+            new_kf = change.new.kf,
+            old_kalpha = change.old.kalpha,
+            new_kalpha = change.new.kalpha,
+            "tuned"
+        );
+        Reply::Ok {
+            message: format!(
+                "{}: kf {} -> {} N, kalpha {} -> {} rad/s²; takes effect at the next tick; saved to {}",
+                FINGER_NAMES[change.finger],
+                change.old.kf,
+                change.new.kf,
+                change.old.kalpha,
+                change.new.kalpha,
+                self.config_path.display()
+            ),
+            status: None,
         }
     }
 }

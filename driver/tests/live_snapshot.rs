@@ -23,6 +23,28 @@ fn worst_case_bits(f: &CanFrame) -> u64 {
     47 + d + (34 + d - 1) / 4
 }
 
+/// Fingers against the controllers' last reports, channels against the engine's features.
+fn check_fingers_and_channels(live: &Live, upto: &[&(u64, CanFrame)], features: &[f64]) {
+    for f in 0..5 {
+        let last = upto
+            .iter()
+            .rev()
+            .find(|(_, fr)| FingerStatus::instance_of(fr.raw_id()) == Some(f))
+            .map(|(_, fr)| FingerStatus::decode(fr.raw_id(), fr.data()).expect("decodes"))
+            .expect("the controller reported");
+        let fl = &live.fingers[f];
+        assert_eq!(fl.reported_position_rad, last.position(), "finger {f}");
+        assert_eq!(fl.reported_force_n, last.force(), "finger {f}");
+        assert!(fl.active && !fl.disabled, "finger {f}: {fl:?}");
+    }
+    assert_eq!(live.channels.len(), 12);
+    for (c, ch) in live.channels.iter().enumerate() {
+        assert!(ch.rms_uv > 0.0, "channel {c}");
+        assert_eq!(ch.rms_uv, features[c * 8], "channel {c}: the RMS feature");
+        assert!(!ch.lead_off && !ch.saturated, "channel {c}");
+    }
+}
+
 #[test]
 fn a_live_line_matches_the_bus() {
     let mut script = Script::new();
@@ -63,25 +85,7 @@ fn a_live_line_matches_the_bus() {
     );
     println!("bus load over the last second: {:.3}", live.bus_load);
 
-    for f in 0..5 {
-        let last = upto
-            .iter()
-            .rev()
-            .find(|(_, fr)| FingerStatus::instance_of(fr.raw_id()) == Some(f))
-            .map(|(_, fr)| FingerStatus::decode(fr.raw_id(), fr.data()).expect("decodes"))
-            .expect("the controller reported");
-        let fl = &live.fingers[f];
-        assert_eq!(fl.reported_position_rad, last.position(), "finger {f}");
-        assert_eq!(fl.reported_force_n, last.force(), "finger {f}");
-        assert!(fl.active && !fl.disabled, "finger {f}: {fl:?}");
-    }
-    let features = rig.runner.engine().model_features();
-    assert_eq!(live.channels.len(), 12);
-    for (c, ch) in live.channels.iter().enumerate() {
-        assert!(ch.rms_uv > 0.0, "channel {c}");
-        assert_eq!(ch.rms_uv, features[c * 8], "channel {c}: the RMS feature");
-        assert!(!ch.lead_off && !ch.saturated, "channel {c}");
-    }
+    check_fingers_and_channels(&live, &upto, rig.runner.engine().model_features());
     assert_eq!(live.rest_rms_uv, None);
 
     let line = serde_json::to_string(&live).expect("serialises");

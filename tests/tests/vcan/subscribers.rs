@@ -4,22 +4,19 @@
 
 use std::io::{Read, Write};
 use std::os::unix::net::UnixStream;
+use std::path::Path;
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
+
+use driver::live::Live;
 
 use super::Rig;
 
-#[test]
-fn h_twenty_subscribers_ten_stuck_no_deadline_miss() {
-    let mut rig = Rig::start("subscribers", 100);
-    let mut sim = rig.sim("sine", 9.0, &[]);
-    std::thread::sleep(Duration::from_millis(2_000));
-    let st0 = rig.cfg.status(&rig.env);
-    let socket = rig.cfg.socket.clone();
-
-    let until = Instant::now() + Duration::from_secs(4);
-    let readers: Vec<_> = (0..10)
+/// Ten subscribers that read every line until `until`.
+fn spawn_readers(socket: &Path, until: Instant) -> Vec<JoinHandle<Vec<Live>>> {
+    (0..10)
         .map(|_| {
-            let socket = socket.clone();
+            let socket = socket.to_path_buf();
             std::thread::spawn(move || {
                 let sub = driver::control::subscribe(&socket, Some(50)).expect("subscribed");
                 let mut lines = Vec::new();
@@ -32,7 +29,42 @@ fn h_twenty_subscribers_ten_stuck_no_deadline_miss() {
                 lines
             })
         })
-        .collect();
+        .collect()
+}
+
+/// A reading subscriber's lines over 4 s of the closed loop.
+fn check_reader(i: usize, lines: &[Live]) {
+    assert!(
+        lines.len() >= 40,
+        "reader {i}: {} lines in 4 s",
+        lines.len()
+    );
+    assert!(
+        lines.windows(2).all(|w| w[1].tick > w[0].tick),
+        "reader {i}: ticks go forward"
+    );
+    let last = lines.last().expect("a line");
+    assert_eq!(last.state, "RUNNING", "reader {i}: {last:?}");
+    assert!(last.counters.frames_rx > 0, "reader {i}: {last:?}");
+    // hand.dbc's worst case for the whole bus is 46.4 % (mostly the EMG frames).
+    assert!(
+        last.bus_load > 0.3 && last.bus_load < 0.55,
+        "reader {i}: bus load {}",
+        last.bus_load
+    );
+    assert!(last.channels.iter().any(|c| c.rms_uv > 0.0), "{last:?}");
+}
+
+#[test]
+fn h_twenty_subscribers_ten_stuck_no_deadline_miss() {
+    let mut rig = Rig::start("subscribers", 100);
+    let mut sim = rig.sim("sine", 9.0, &[]);
+    std::thread::sleep(Duration::from_millis(2_000));
+    let st0 = rig.cfg.status(&rig.env);
+    let socket = rig.cfg.socket.clone();
+
+    let until = Instant::now() + Duration::from_secs(4);
+    let readers = spawn_readers(&socket, until);
     let stuck: Vec<UnixStream> = (0..10)
         .map(|_| {
             let mut s = UnixStream::connect(&socket).expect("connect");
@@ -43,25 +75,7 @@ fn h_twenty_subscribers_ten_stuck_no_deadline_miss() {
         .collect();
 
     for (i, r) in readers.into_iter().enumerate() {
-        let lines = r.join().expect("reader");
-        assert!(
-            lines.len() >= 40,
-            "reader {i}: {} lines in 4 s",
-            lines.len()
-        );
-        assert!(
-            lines.windows(2).all(|w| w[1].tick > w[0].tick),
-            "reader {i}: ticks go forward"
-        );
-        let last = lines.last().expect("a line");
-        assert_eq!(last.state, "RUNNING", "reader {i}: {last:?}");
-        assert!(last.counters.frames_rx > 0, "reader {i}: {last:?}");
-        assert!(
-            last.bus_load > 0.0 && last.bus_load < 0.5,
-            "{}",
-            last.bus_load
-        );
-        assert!(last.channels.iter().any(|c| c.rms_uv > 0.0), "{last:?}");
+        check_reader(i, &r.join().expect("reader"));
     }
     for (i, mut s) in stuck.into_iter().enumerate() {
         s.set_read_timeout(Some(Duration::from_secs(3)))
