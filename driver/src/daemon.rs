@@ -9,11 +9,12 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::Receiver;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, TryLockError};
 
 use hand_clock::Clock;
 use hand_dbc::CanFrame;
 
+use crate::bus_load::BusLoad;
 use crate::conditioner::{FingerGains, Setpoint};
 use crate::engine::{Command, Counters, Engine};
 use crate::safety::{DaemonState, Fault, FaultSet, FingerEvent};
@@ -21,9 +22,15 @@ use crate::stats::Percentiles;
 use crate::transport::{Transport, TransportError};
 use crate::units::{FINGER_NAMES, N_FINGERS};
 
-/// What `handctl status` shows, copied out of the loop every tick without allocating.
+/// EMG channels a snapshot holds (the bus's).
+pub const SNAPSHOT_CHANNELS: usize = hand_dbc::emg::EMG_CHANNELS;
+
+/// What `handctl status` and the live subscription show, copied out of the loop every tick
+/// without allocating.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Snapshot {
+    /// The tick's deadline, µs on the daemon's clock.
+    pub t_us: u64,
     /// State.
     pub state: DaemonState,
     /// Faults in force.
@@ -48,6 +55,27 @@ pub struct Snapshot {
     pub gains: [FingerGains; N_FINGERS],
     /// Whether the bus is usable.
     pub bus_ok: bool,
+    /// Joint angles the controllers report, rad.
+    pub reported_position: [f64; N_FINGERS],
+    /// Whether each finger's setpoint was ACTIVE mode.
+    pub active: [bool; N_FINGERS],
+    /// EMG channels in use (the first entries of `channel_rms_uv`).
+    pub channels: usize,
+    /// Per channel, the RMS feature the model last ran on, µV.
+    pub channel_rms_uv: [f64; SNAPSHOT_CHANNELS],
+    /// The amplifier's last lead-off mask (bit c = channel c).
+    pub lead_off_mask: u16,
+    /// The amplifier's last saturation mask.
+    pub saturation_mask: u16,
+    /// Frames read from the bus since start.
+    pub frames_rx: u64,
+    /// Frames sent since start.
+    pub frames_tx: u64,
+    /// Worst-case bus load over the last second, fraction of the bit rate.
+    pub bus_load: f64,
+    /// Ticks whose snapshot was not published because a reader held it (the tick never
+    /// waits for one): a measure of reader contention.
+    pub publish_skips: u64,
 }
 
 impl Default for Snapshot {
@@ -65,12 +93,28 @@ impl Default for Snapshot {
             disabled: [false; N_FINGERS],
             gains: [FingerGains::default(); N_FINGERS],
             bus_ok: true,
+            t_us: 0,
+            reported_position: [0.0; N_FINGERS],
+            active: [false; N_FINGERS],
+            channels: 0,
+            channel_rms_uv: [0.0; SNAPSHOT_CHANNELS],
+            lead_off_mask: 0,
+            saturation_mask: 0,
+            frames_rx: 0,
+            frames_tx: 0,
+            bus_load: 0.0,
+            publish_skips: 0,
         }
     }
 }
 
-/// The snapshot shared with the control thread.
+/// The snapshot shared with the control threads. The tick only ever `try_lock`s it (a
+/// reader holds it for a copy); readers copy it out and release it at once.
 pub type SharedSnapshot = Arc<Mutex<Snapshot>>;
+
+/// Most technicians' commands one tick applies; the rest wait for the next tick (the
+/// control side's queue is bounded too, so a flood of commands cannot lengthen a tick).
+pub const MAX_COMMANDS_PER_TICK: usize = 8;
 
 /// First and longest wait between attempts to reopen a failed bus, µs. Short, because the
 /// first frames after a reopen are the safe stops the finger controllers need within 100 ms;
@@ -92,6 +136,10 @@ pub struct Runner<T: Transport, K: Clock> {
     last_tick_on_time: bool,
     /// A frame received after the deadline of the tick that read it, for the next tick.
     held: Option<(CanFrame, u64)>,
+    frames_rx: u64,
+    frames_tx: u64,
+    bus_load: BusLoad,
+    publish_skips: u64,
 }
 
 impl<T: Transport, K: Clock> Runner<T, K> {
@@ -111,6 +159,10 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             snapshot: Arc::new(Mutex::new(Snapshot::default())),
             last_tick_on_time: true,
             held: None,
+            frames_rx: 0,
+            frames_tx: 0,
+            bus_load: BusLoad::new(tick_us),
+            publish_skips: 0,
         }
     }
 
@@ -218,6 +270,12 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         }
     }
 
+    fn received(&mut self, frame: &CanFrame, rx_us: u64) {
+        self.frames_rx += 1;
+        self.bus_load.frame(frame);
+        self.engine.on_frame(frame, rx_us);
+    }
+
     /// Read every waiting frame received up to `until_us` (the tick's deadline) into the
     /// engine. The first frame received after it is held back for the next tick, so what a
     /// tick computes depends on its deadline alone, not on how late it woke up.
@@ -230,7 +288,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
                 return;
             }
             self.held = None;
-            self.engine.on_frame(&frame, rx_us);
+            self.received(&frame, rx_us);
         }
         loop {
             match self.transport.try_recv() {
@@ -238,7 +296,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
                     self.held = Some((frame, rx_us));
                     break;
                 }
-                Ok(Some((frame, rx_us))) => self.engine.on_frame(&frame, rx_us),
+                Ok(Some((frame, rx_us))) => self.received(&frame, rx_us),
                 Ok(None) => break,
                 Err(e) => {
                     let now = self.clock.now_us();
@@ -256,13 +314,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         let deadline = self.next_deadline_us;
         self.try_reopen(now);
         self.drain(deadline);
-        if let Some(rx) = &self.commands {
-            while let Ok(cmd) = rx.try_recv() {
-                if let Err(e) = self.engine.command(deadline, cmd) {
-                    tracing::warn!(error = %e, "command refused");
-                }
-            }
-        }
+        self.apply_commands(deadline);
         let t0 = self.clock.now_us();
         self.last_tick_on_time = self.engine.on_time(t0, deadline);
         let frames = self.engine.tick(deadline, t0);
@@ -273,8 +325,11 @@ impl<T: Transport, K: Clock> Runner<T, K> {
                     failed = Some(e);
                     break;
                 }
+                self.frames_tx += 1;
+                self.bus_load.frame(f);
             }
         }
+        self.bus_load.close_tick();
         let t1 = self.clock.now_us();
         if let Some(e) = failed {
             self.bus_failed(t1, &e);
@@ -287,7 +342,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
                 FingerEvent::Enabled(f) => tracing::info!(finger = FINGER_NAMES[f], "finger controller back: finger enabled"),
             },
         );
-        self.publish();
+        self.publish(deadline);
         self.next_deadline_us += self.tick_us;
         // After a long stall, skip the missed ticks rather than run them back to back.
         if self.next_deadline_us + self.tick_us < t1 {
@@ -296,9 +351,27 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         }
     }
 
-    fn publish(&self) {
+    /// At most [`MAX_COMMANDS_PER_TICK`] waiting commands, at the tick's deadline.
+    fn apply_commands(&mut self, deadline: u64) {
+        let Some(rx) = &self.commands else { return };
+        for _ in 0..MAX_COMMANDS_PER_TICK {
+            let Ok(cmd) = rx.try_recv() else { break };
+            if let Err(e) = self.engine.command(deadline, cmd) {
+                tracing::warn!(error = %e, "command refused");
+            }
+        }
+    }
+
+    /// Copies the tick's figures into the shared snapshot, if no reader holds it (the tick
+    /// never waits: a skipped tick is counted and the next one publishes).
+    fn publish(&mut self, deadline: u64) {
         let e = &self.engine;
+        let features = e.model_features();
+        let per = decoder::dsp::FEATURES_PER_CHANNEL;
+        let channels = e.n_channels().min(SNAPSHOT_CHANNELS);
+        let (lead_off_mask, saturation_mask) = e.amp_masks();
         let snap = Snapshot {
+            t_us: deadline,
             state: e.state(),
             faults: e.faults(),
             counters: e.counters(),
@@ -311,9 +384,29 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             disabled: std::array::from_fn(|f| e.finger_disabled(f)),
             gains: *e.gains(),
             bus_ok: self.bus_ok,
+            reported_position: *e.reported_position(),
+            active: std::array::from_fn(|f| e.finger_active(f)),
+            channels,
+            // RMS is the first feature of each channel (decoder::dsp::FEATURE_NAMES).
+            channel_rms_uv: std::array::from_fn(|c| {
+                if c < channels {
+                    features.get(c * per).copied().unwrap_or(0.0)
+                } else {
+                    0.0
+                }
+            }),
+            lead_off_mask,
+            saturation_mask,
+            frames_rx: self.frames_rx,
+            frames_tx: self.frames_tx,
+            bus_load: self.bus_load.load(),
+            publish_skips: self.publish_skips,
         };
-        if let Ok(mut s) = self.snapshot.try_lock() {
-            *s = snap;
+        match self.snapshot.try_lock() {
+            Ok(mut s) => *s = snap,
+            // A reader that panicked cannot have left a half-written copy: take it over.
+            Err(TryLockError::Poisoned(p)) => *p.into_inner() = snap,
+            Err(TryLockError::WouldBlock) => self.publish_skips += 1,
         }
     }
 

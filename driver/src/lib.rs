@@ -5,6 +5,7 @@
 //! Features (none by default, which is the daemon's build): `sim` adds the demo and the
 //! in-memory transport on the simulator (`hand-model`). `handd` neither needs nor links it.
 
+pub mod bus_load;
 pub mod conditioner;
 pub mod config;
 pub mod control;
@@ -12,6 +13,7 @@ pub mod daemon;
 #[cfg(feature = "sim")]
 pub mod demo;
 pub mod engine;
+pub mod live;
 #[cfg(feature = "sim")]
 pub mod mem_transport;
 pub mod protocol;

@@ -1,5 +1,6 @@
 //! The technicians' control protocol between `handctl` and `handd`: one JSON object per line
-//! over a Unix socket, one request and one reply per connection.
+//! over a Unix socket, one request and one reply per connection; after a `subscribe` reply the
+//! daemon goes on writing one [`crate::live::Live`] per line until the client closes.
 
 use serde::{Deserialize, Serialize};
 
@@ -26,6 +27,33 @@ pub enum Request {
     Arm,
     /// Go to SAFE and stay there until `arm`.
     Stop,
+    /// Stream one [`crate::live::Live`] line every `every_ms` (rounded to whole ticks) until
+    /// the client closes.
+    Subscribe {
+        /// Period, ms: at least one tick, at most [`MAX_SUBSCRIBE_MS`]; [`DEFAULT_SUBSCRIBE_MS`]
+        /// when left out.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        every_ms: Option<u64>,
+    },
+}
+
+/// A subscription's period when the request names none, ms.
+pub const DEFAULT_SUBSCRIBE_MS: u64 = 100;
+/// The longest subscription period, ms.
+pub const MAX_SUBSCRIBE_MS: u64 = 60_000;
+
+/// The ticks between two lines of a subscription asking for `every_ms` on a loop ticking every
+/// `tick_ms`: `every_ms` rounded to whole ticks. Refused, with the allowed range, below one
+/// tick or above [`MAX_SUBSCRIBE_MS`].
+pub fn subscribe_ticks(every_ms: Option<u64>, tick_ms: u64) -> Result<u64, String> {
+    let every = every_ms.unwrap_or(DEFAULT_SUBSCRIBE_MS);
+    let tick_ms = tick_ms.max(1);
+    if every < tick_ms || every > MAX_SUBSCRIBE_MS {
+        return Err(format!(
+            "every_ms {every} is out of range: {tick_ms} (one tick) to {MAX_SUBSCRIBE_MS}"
+        ));
+    }
+    Ok(((every + tick_ms / 2) / tick_ms).max(1))
 }
 
 /// One finger's live values in a status reply.
@@ -98,10 +126,47 @@ pub const MAX_REQUEST_BYTES: usize = 4096;
 
 /// Parse one request line, with a message fit for the technician on error.
 pub fn parse_request(line: &str) -> Result<Request, String> {
+    parse_request_bytes(line.as_bytes())
+}
+
+/// Parse one request line as received (not necessarily UTF-8), with a message fit for the
+/// technician on error.
+pub fn parse_request_bytes(line: &[u8]) -> Result<Request, String> {
     if line.len() > MAX_REQUEST_BYTES {
         return Err(format!("request longer than {MAX_REQUEST_BYTES} bytes"));
     }
-    serde_json::from_str(line.trim()).map_err(|e| format!("malformed request: {e}"))
+    let line = std::str::from_utf8(line)
+        .map_err(|e| format!("malformed request: not UTF-8 text ({e})"))?;
+    let malformed = |e: serde_json::Error| format!("malformed request: {e}");
+    let value: serde_json::Value = serde_json::from_str(line.trim()).map_err(malformed)?;
+    let req: Request = Request::deserialize(&value).map_err(malformed)?;
+    // serde ignores unknown fields beside the tag of a variant without fields: check them all.
+    let allowed = req.fields();
+    if let Some(extra) = value.as_object().and_then(|o| {
+        o.keys()
+            .find(|k| k.as_str() != "cmd" && !allowed.contains(&k.as_str()))
+    }) {
+        return Err(format!(
+            "malformed request: unknown field `{extra}` (this command takes {})",
+            if allowed.is_empty() {
+                "none".to_owned()
+            } else {
+                allowed.join(", ")
+            }
+        ));
+    }
+    Ok(req)
+}
+
+impl Request {
+    /// The fields this command takes besides `cmd`.
+    fn fields(&self) -> &'static [&'static str] {
+        match self {
+            Request::Status | Request::Arm | Request::Stop => &[],
+            Request::Tune { .. } => &["finger", "kf", "kalpha"],
+            Request::Subscribe { .. } => &["every_ms"],
+        }
+    }
 }
 
 #[cfg(test)]
@@ -114,6 +179,10 @@ mod tests {
             Request::Status,
             Request::Arm,
             Request::Stop,
+            Request::Subscribe { every_ms: None },
+            Request::Subscribe {
+                every_ms: Some(250),
+            },
             Request::Tune {
                 finger: "index".into(),
                 kf: Some(0.8),
@@ -134,6 +203,27 @@ mod tests {
     }
 
     #[test]
+    fn subscription_periods_round_to_ticks_within_range() {
+        assert_eq!(
+            parse_request(r#"{"cmd":"subscribe"}"#).unwrap(),
+            Request::Subscribe { every_ms: None }
+        );
+        assert_eq!(subscribe_ticks(None, 50), Ok(2));
+        assert_eq!(subscribe_ticks(Some(50), 50), Ok(1));
+        assert_eq!(subscribe_ticks(Some(74), 50), Ok(1));
+        assert_eq!(subscribe_ticks(Some(75), 50), Ok(2));
+        assert_eq!(subscribe_ticks(Some(60_000), 50), Ok(1200));
+        for bad in [0, 49, 60_001] {
+            let e = subscribe_ticks(Some(bad), 50).unwrap_err();
+            assert!(
+                e.contains(&bad.to_string()) && e.contains("50 (one tick)"),
+                "{e}"
+            );
+        }
+        assert!(parse_request(r#"{"cmd":"subscribe","every_ms":-5}"#).is_err());
+    }
+
+    #[test]
     fn malformed_requests_are_refused_with_a_reason() {
         assert!(parse_request("").unwrap_err().contains("malformed"));
         assert!(parse_request(r#"{"cmd":"explode"}"#)
@@ -143,5 +233,20 @@ mod tests {
         assert!(parse_request(&"x".repeat(5000))
             .unwrap_err()
             .contains("longer"));
+        for (line, field) in [
+            (r#"{"cmd":"status","extra":1}"#, "extra"),
+            (r#"{"cmd":"stop","force":true}"#, "force"),
+            (r#"{"cmd":"tune","finger":"index","kff":1}"#, "kff"),
+            (r#"{"cmd":"subscribe","every":100}"#, "every"),
+        ] {
+            let e = parse_request(line).unwrap_err();
+            assert!(
+                e.contains(&format!("unknown field `{field}`")),
+                "{line}: {e}"
+            );
+        }
+        assert!(parse_request_bytes(b"{\"cmd\":\"st\xffatus\"}")
+            .unwrap_err()
+            .contains("UTF-8"));
     }
 }

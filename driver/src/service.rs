@@ -1,8 +1,12 @@
 //! The daemon's side of the technicians' protocol: answers `status`, applies `tune` (checked,
 //! persisted atomically, audited, then handed to the loop for the next tick), `arm` and `stop`.
+//! Every request is checked completely before anything is applied. Commands reach the loop
+//! through a bounded queue ([`COMMAND_QUEUE`]); the tick takes at most
+//! [`crate::daemon::MAX_COMMANDS_PER_TICK`] per tick, so a flood of commands waits here (the
+//! sender blocks) rather than lengthening a tick.
 
 use std::path::PathBuf;
-use std::sync::mpsc::Sender;
+use std::sync::mpsc::SyncSender;
 
 use crate::config::Config;
 use crate::control::Peer;
@@ -12,12 +16,16 @@ use crate::protocol::{FingerStatus, Reply, Request, Status};
 use crate::tuning::{commit_tune, plan_tune, user_name};
 use crate::units::{FINGER_NAMES, N_FINGERS};
 
+/// Commands waiting for the loop at most; make the channel with
+/// `std::sync::mpsc::sync_channel(COMMAND_QUEUE)`.
+pub const COMMAND_QUEUE: usize = 16;
+
 /// Handles control requests for a running loop.
 pub struct ControlHandler {
     config: Config,
     config_path: PathBuf,
     snapshot: SharedSnapshot,
-    commands: Sender<Command>,
+    commands: SyncSender<Command>,
 }
 
 impl ControlHandler {
@@ -27,7 +35,7 @@ impl ControlHandler {
         config: Config,
         config_path: PathBuf,
         snapshot: SharedSnapshot,
-        commands: Sender<Command>,
+        commands: SyncSender<Command>,
     ) -> Self {
         Self {
             config,
@@ -64,10 +72,12 @@ impl ControlHandler {
         }
     }
 
+    /// Hands `cmd` to the loop, waiting while its queue is full (a tick or two at most: the
+    /// loop takes several per tick); fails only when the loop is gone.
     fn send(&self, cmd: Command) -> Result<(), Box<Reply>> {
         self.commands.send(cmd).map_err(|_| {
             Box::new(Reply::Refused {
-                reason: "the control loop is not running".into(),
+                reason: "the control loop is not running; nothing changed".into(),
             })
         })
     }
@@ -80,41 +90,7 @@ impl ControlHandler {
                 message: "status".into(),
                 status: Some(self.status()),
             },
-            Request::Tune { finger, kf, kalpha } => {
-                let change = match plan_tune(&self.config, &finger, kf, kalpha) {
-                    Ok(c) => c,
-                    Err(reason) => return Reply::Refused { reason },
-                };
-                let next = match commit_tune(&self.config, &change, &self.config_path, &user) {
-                    Ok(n) => n,
-                    Err(reason) => return Reply::Refused { reason },
-                };
-                if let Err(r) = self.send(Command::SetGains(change.finger, change.new.gains())) {
-                    return *r;
-                }
-                self.config = next;
-                tracing::info!(
-                    user,
-                    finger = FINGER_NAMES[change.finger],
-                    old_kf = change.old.kf,
-                    new_kf = change.new.kf,
-                    old_kalpha = change.old.kalpha,
-                    new_kalpha = change.new.kalpha,
-                    "tuned"
-                );
-                Reply::Ok {
-                    message: format!(
-                        "{}: kf {} -> {} N, kalpha {} -> {} rad/s²; takes effect at the next tick; saved to {}",
-                        FINGER_NAMES[change.finger],
-                        change.old.kf,
-                        change.new.kf,
-                        change.old.kalpha,
-                        change.new.kalpha,
-                        self.config_path.display()
-                    ),
-                    status: None,
-                }
-            }
+            Request::Tune { finger, kf, kalpha } => self.tune(&finger, kf, kalpha, &user),
             Request::Arm => match self.send(Command::Arm) {
                 Ok(()) => {
                     tracing::warn!(user, "armed by a technician");
@@ -124,6 +100,9 @@ impl ControlHandler {
                     }
                 }
                 Err(r) => *r,
+            },
+            Request::Subscribe { .. } => Reply::Refused {
+                reason: "subscribe is served by the control socket, not by this handler".into(),
             },
             Request::Stop => match self.send(Command::Stop) {
                 Ok(()) => {
@@ -135,6 +114,48 @@ impl ControlHandler {
                 }
                 Err(r) => *r,
             },
+        }
+    }
+
+    /// `tune`: checked completely, saved, then handed to the loop; refused with nothing
+    /// changed on any failure.
+    fn tune(&mut self, finger: &str, kf: Option<f64>, kalpha: Option<f64>, user: &str) -> Reply {
+        let change = match plan_tune(&self.config, finger, kf, kalpha) {
+            Ok(c) => c,
+            Err(reason) => return Reply::Refused { reason },
+        };
+        let next = match commit_tune(&self.config, &change, &self.config_path, user) {
+            Ok(n) => n,
+            Err(reason) => return Reply::Refused { reason },
+        };
+        if let Err(r) = self.send(Command::SetGains(change.finger, change.new.gains())) {
+            // Nothing partly applied: the loop never saw it, so the file goes back.
+            if let Err(e) = self.config.save_atomic(&self.config_path) {
+                tracing::error!(error = %e, "tune: the config could not be restored");
+            }
+            return *r;
+        }
+        self.config = next;
+        tracing::info!(
+            user,
+            finger = FINGER_NAMES[change.finger],
+            old_kf = change.old.kf,
+            new_kf = change.new.kf,
+            old_kalpha = change.old.kalpha,
+            new_kalpha = change.new.kalpha,
+            "tuned"
+        );
+        Reply::Ok {
+            message: format!(
+                "{}: kf {} -> {} N, kalpha {} -> {} rad/s²; takes effect at the next tick; saved to {}",
+                FINGER_NAMES[change.finger],
+                change.old.kf,
+                change.new.kf,
+                change.old.kalpha,
+                change.new.kalpha,
+                self.config_path.display()
+            ),
+            status: None,
         }
     }
 }

@@ -44,7 +44,7 @@ fn tune_changes_the_force_by_the_ratio_within_two_ticks_and_persists() {
         .rest(500_000)
         .hold(Intent::finger(1, 0.8), 30_000_000);
     let mut rig = Rig::new(FaultPlan::new(), script);
-    let (tx, rx) = mpsc::channel();
+    let (tx, rx) = mpsc::sync_channel(driver::service::COMMAND_QUEUE);
     rig.runner.set_commands(rx);
     let handler = ControlHandler::new(
         config.clone(),

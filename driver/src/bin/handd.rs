@@ -12,11 +12,12 @@ use std::time::{Duration, Instant};
 use clap::Parser;
 use decoder::model::Model as _;
 use driver::config::{Config, DEFAULT_CONFIG_PATH};
-use driver::control::ControlServer;
+use driver::control::{ControlServer, LiveFeed};
 use driver::daemon::Runner;
 use driver::engine::Engine;
+use driver::live::ModelInfo;
 use driver::rt::{lock_memory, set_fifo, RtReport};
-use driver::service::ControlHandler;
+use driver::service::{ControlHandler, COMMAND_QUEUE};
 use driver::socketcan_bus::SocketCanTransport;
 use driver::startup::{engine_settings, load_model, remove_stale_temps};
 use hand_clock::{Clock, SystemClock};
@@ -129,10 +130,20 @@ fn run(args: &Args) -> Result<(), String> {
     );
     engine.validated(clock.now_us());
 
-    let (tx, rx) = mpsc::channel();
+    let (tx, rx) = mpsc::sync_channel(COMMAND_QUEUE);
     let mut runner = Runner::new(engine, transport, clock, config.tick_ms * 1000).with_commands(rx);
+    let live = LiveFeed {
+        snapshot: runner.snapshot(),
+        model: ModelInfo {
+            id: format!("{:08x}", loaded.model_id),
+            path: config.model.display().to_string(),
+            kind: loaded.model.model().kind().to_string(),
+        },
+        tick_us: config.tick_ms * 1000,
+    };
     let server = ControlServer::bind(&config.control.socket, config.control.group.as_deref())
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| e.to_string())?
+        .with_live(live);
     let mut handler =
         ControlHandler::new(config.clone(), args.config.clone(), runner.snapshot(), tx);
     std::thread::Builder::new()

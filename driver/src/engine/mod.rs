@@ -310,6 +310,22 @@ impl Engine {
     pub fn reported_force(&self) -> &[f64; N_FINGERS] {
         &self.inputs.reported_force
     }
+    /// Joint angle each finger controller last reported, rad.
+    pub fn reported_position(&self) -> &[f64; N_FINGERS] {
+        &self.inputs.reported_position
+    }
+    /// The amplifier's last lead-off and saturation masks (bit c = channel c).
+    pub fn amp_masks(&self) -> (u16, u16) {
+        self.inputs.amp_masks
+    }
+    /// EMG channels of the chain.
+    pub fn n_channels(&self) -> usize {
+        self.emg.chain.settings().n_channels()
+    }
+    /// Whether finger `f`'s last setpoint was ACTIVE mode (outputs on, finger not disabled).
+    pub fn finger_active(&self, f: usize) -> bool {
+        self.safety.outputs_enabled() && !self.watch.is_disabled(f)
+    }
     /// Whether finger `f` is disabled.
     pub fn finger_disabled(&self, f: usize) -> bool {
         self.watch.is_disabled(f)

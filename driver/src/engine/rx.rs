@@ -119,6 +119,10 @@ pub(super) struct Inputs {
     pub(super) amp_reports_bad: bool,
     /// Force each finger controller last reported, N.
     pub(super) reported_force: [f64; N_FINGERS],
+    /// Joint angle each finger controller last reported, rad.
+    pub(super) reported_position: [f64; N_FINGERS],
+    /// The amplifier's last lead-off and saturation masks (bit c = channel c).
+    pub(super) amp_masks: (u16, u16),
 }
 
 fn checker(profile: E2eProfile, max_delta: u16) -> E2eChecker {
@@ -133,6 +137,8 @@ impl Inputs {
             amp_status: checker(EmgStatus::E2E, 3),
             amp_reports_bad: false,
             reported_force: [0.0; N_FINGERS],
+            reported_position: [0.0; N_FINGERS],
+            amp_masks: (0, 0),
         }
     }
 }
@@ -175,6 +181,7 @@ impl Engine {
                     E2eStatus::Ok => {
                         self.watch.heard(f, rx_us);
                         self.inputs.reported_force[f] = s.force();
+                        self.inputs.reported_position[f] = s.position();
                     }
                     E2eStatus::Repeated => {}
                     _ => self.counters.e2e_errors += 1,
@@ -182,6 +189,7 @@ impl Engine {
             }
             Message::EmgStatus(st) => match self.inputs.amp_status.check(Some(data)) {
                 E2eStatus::Ok | E2eStatus::WrongSequence => {
+                    self.inputs.amp_masks = (st.lead_off_mask(), st.saturation_mask());
                     self.inputs.amp_reports_bad = st.lead_off_mask() != 0
                         || st.saturation_mask() != 0
                         || st.state() == AmpState::Fault;

@@ -1,0 +1,103 @@
+//! Issue 13 over vcan: a flood of live subscribers against the real handd while handsim runs
+//! the closed loop. Half of them never read: they are dropped (their sockets end, handd logs
+//! it), the readers keep receiving one line per tick, and no tick misses its deadline.
+
+use std::io::{Read, Write};
+use std::os::unix::net::UnixStream;
+use std::path::Path;
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use driver::live::Live;
+
+use super::Rig;
+
+/// Ten subscribers that read every line until `until`.
+fn spawn_readers(socket: &Path, until: Instant) -> Vec<JoinHandle<Vec<Live>>> {
+    (0..10)
+        .map(|_| {
+            let socket = socket.to_path_buf();
+            std::thread::spawn(move || {
+                let sub = driver::control::subscribe(&socket, Some(50)).expect("subscribed");
+                let mut lines = Vec::new();
+                for live in sub {
+                    lines.push(live.expect("a Live line"));
+                    if Instant::now() >= until {
+                        break;
+                    }
+                }
+                lines
+            })
+        })
+        .collect()
+}
+
+/// A reading subscriber's lines over 4 s of the closed loop.
+fn check_reader(i: usize, lines: &[Live]) {
+    assert!(
+        lines.len() >= 40,
+        "reader {i}: {} lines in 4 s",
+        lines.len()
+    );
+    assert!(
+        lines.windows(2).all(|w| w[1].tick > w[0].tick),
+        "reader {i}: ticks go forward"
+    );
+    let last = lines.last().expect("a line");
+    assert_eq!(last.state, "RUNNING", "reader {i}: {last:?}");
+    assert!(last.counters.frames_rx > 0, "reader {i}: {last:?}");
+    // hand.dbc's worst case for the whole bus is 46.4 % (mostly the EMG frames).
+    assert!(
+        last.bus_load > 0.3 && last.bus_load < 0.55,
+        "reader {i}: bus load {}",
+        last.bus_load
+    );
+    assert!(last.channels.iter().any(|c| c.rms_uv > 0.0), "{last:?}");
+}
+
+#[test]
+fn h_twenty_subscribers_ten_stuck_no_deadline_miss() {
+    let mut rig = Rig::start("subscribers", 100);
+    let mut sim = rig.sim("sine", 9.0, &[]);
+    std::thread::sleep(Duration::from_millis(2_000));
+    let st0 = rig.cfg.status(&rig.env);
+    let socket = rig.cfg.socket.clone();
+
+    let until = Instant::now() + Duration::from_secs(4);
+    let readers = spawn_readers(&socket, until);
+    let stuck: Vec<UnixStream> = (0..10)
+        .map(|_| {
+            let mut s = UnixStream::connect(&socket).expect("connect");
+            s.write_all(b"{\"cmd\":\"subscribe\",\"every_ms\":50}\n")
+                .expect("sent");
+            s
+        })
+        .collect();
+
+    for (i, r) in readers.into_iter().enumerate() {
+        check_reader(i, &r.join().expect("reader"));
+    }
+    for (i, mut s) in stuck.into_iter().enumerate() {
+        s.set_read_timeout(Some(Duration::from_secs(3)))
+            .expect("timeout");
+        let mut rest = Vec::new();
+        let r = s.read_to_end(&mut rest);
+        assert!(r.is_ok(), "stuck subscriber {i} was not dropped: {r:?}");
+    }
+    let st = rig.cfg.status(&rig.env);
+    sim.wait_success(Duration::from_secs(60));
+    let dropped = rig
+        .handd
+        .output()
+        .matches("live subscriber dropped")
+        .count();
+    let misses = st.deadline_misses - st0.deadline_misses;
+    println!(
+        "subscribers: {misses} deadline misses with 20 subscribers (10 stuck, {dropped} drop \
+         log lines); lateness p99 {} us, max {} us",
+        st.lateness.p99_us, st.lateness.max_us
+    );
+    assert!(dropped >= 10, "handd logged {dropped} dropped subscribers");
+    assert_eq!(misses, 0, "handd missed deadlines with 20 subscribers");
+    assert!(rig.handd.running(), "handd died:\n{}", rig.handd.output());
+}
