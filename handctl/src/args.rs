@@ -311,7 +311,9 @@ fn parse_mains(s: &str) -> Result<u32, String> {
 /// `handctl decode`.
 #[derive(Debug, Args)]
 pub struct DecodeArgs {
-    /// Session directory (or 3dc:DIR:train|test) whose whole recording is decoded.
+    /// Session directory (or 3dc:DIR:train|test) whose whole recording is decoded; or a bare
+    /// recording file, read with the model's channels and rate: a candump log (.log) or
+    /// samples (.npy, .csv, every column a channel).
     pub session: String,
     /// Model file (trained on the same signal chain as the session's).
     #[arg(long)]

@@ -1,4 +1,5 @@
-//! `handctl decode`: a model run over every window of a session's recording, written as CSV
+//! `handctl decode`: a model run over every window of a session's recording (or of a bare
+//! recording file, read with the model's chain), written as CSV
 //! (time and the five outputs per window, and the reference signal when the session has one);
 //! with a reference, the agreement of the named finger's output (or of every finger's) with
 //! it: R² as is and through the best line, RMSE and Pearson r ([`decoder::eval::agreement`]).
@@ -28,14 +29,19 @@ fn parse_finger(s: &str) -> Result<usize, CliError> {
 /// `handctl decode`.
 pub fn run(a: &DecodeArgs) -> Result<(), CliError> {
     let finger = a.finger.as_deref().map(parse_finger).transpose()?;
-    let session = Session::open_spec(&a.session)?;
+    let model = TrainedModel::load(&a.model, None)?;
+    let path = std::path::Path::new(&a.session);
+    let session = if path.is_file() {
+        Session::open_recording(path, model.chain())?
+    } else {
+        Session::open_spec(&a.session)?
+    };
     if finger.is_some() && session.reference.is_none() {
         return Err(CliError::Usage(format!(
             "{}: --finger compares an output with the session's reference signal, and this session has none (import it with --reference COLUMN)",
             a.session
         )));
     }
-    let model = TrainedModel::load(&a.model, None)?;
     let windows = session.stream_windows()?;
     let decoded = decode(
         &model,

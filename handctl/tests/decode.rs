@@ -12,6 +12,11 @@ fn handctl(args: &[&str]) -> Output {
         .expect("run handctl")
 }
 
+/// Runs a command line given as one string (the test's paths have no spaces).
+fn run(line: &str) -> Output {
+    handctl(&line.split_whitespace().collect::<Vec<_>>())
+}
+
 fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
 }
@@ -118,65 +123,32 @@ fn decode_a_real_recording_against_its_force() {
          all,rest,1,0,1200\nall,flexion,1,1800,3700\nall,rest,2,4300,5000\n",
     )
     .unwrap();
-    let session = dir.join("session");
+    let (session, model, decoded) = (dir.join("s"), dir.join("m.hsm"), dir.join("d.csv"));
+    let (session, model, decoded) = (s(&session), s(&model), s(&decoded));
     let csv = plux_csv();
-    let out = ok(handctl(&[
-        "import",
-        "--samples",
+    let out = ok(run(&format!(
+        "import --samples {} --labels {} --channels 1 --reference force \
+         --ignore-columns time_s -o {session}",
         s(&csv),
-        "--labels",
-        s(&labels),
-        "--channels",
-        "1",
-        "--reference",
-        "force",
-        "--ignore-columns",
-        "time_s",
-        "-o",
-        s(&session),
-    ]));
+        s(&labels)
+    )));
     assert!(out.contains("reference \"force\""), "{out}");
-    let model = dir.join("m.hsm");
-    ok(handctl(&[
-        "train",
-        s(&session),
-        "-o",
-        s(&model),
-        "--epochs",
-        "40",
-        "--validation",
-        "none",
-        "--ignore-gates",
-        "--seed",
-        "1",
-    ]));
-    let decoded = dir.join("decoded.csv");
-    let json = ok(handctl(&[
-        "decode",
-        s(&session),
-        "--model",
-        s(&model),
-        "-o",
-        s(&decoded),
-        "--finger",
-        "index",
-        "--json",
-    ]));
-    let numpy = numpy_agreement(&decoded, &csv, "force", 1000.0, 200, "index");
+    ok(run(&format!(
+        "train {session} -o {model} --epochs 40 --validation none --ignore-gates --seed 1"
+    )));
+    let json = ok(run(&format!(
+        "decode {session} --model {model} -o {decoded} --finger index --json"
+    )));
+    let numpy = numpy_agreement(Path::new(decoded), &csv, "force", 1000.0, 200, "index");
     assert_same_figures(&json, &numpy);
     // 5001 samples, 200-sample windows every 50: 97 windows.
     assert_eq!(numpy["windows"], 97, "{numpy}");
     let r = numpy["pearson_r"].as_f64().unwrap();
     assert!(r > 0.8, "the index output follows the force at r = {r}");
     // The table for a technician: every finger, both R².
-    let table = ok(handctl(&[
-        "decode",
-        s(&session),
-        "--model",
-        s(&model),
-        "-o",
-        s(&decoded),
-    ]));
+    let table = ok(run(&format!(
+        "decode {session} --model {model} -o {decoded}"
+    )));
     assert!(
         table.contains("97 windows") && table.contains("R² line") && table.contains("pinky"),
         "{table}"
@@ -239,52 +211,28 @@ fn synthesise(dir: &Path, channels: usize, rate: f64) -> (PathBuf, PathBuf) {
 fn front_end(channels: usize, rate: f64, window_len: usize, step_len: usize) -> String {
     let dir = tmp(&format!("{channels}ch-{rate}hz"));
     let (samples, labels) = synthesise(&dir, channels, rate);
-    let session = dir.join("session");
-    let imported = ok(handctl(&[
-        "import",
-        "--samples",
+    let (session, model, decoded) = (dir.join("s"), dir.join("m.hsm"), dir.join("d.csv"));
+    let (session, model, decoded) = (s(&session), s(&model), s(&decoded));
+    let imported = ok(run(&format!(
+        "import --samples {} --labels {} --channels {channels} --rate {rate} \
+         --reference angle --ignore-columns time_s -o {session}",
         s(&samples),
-        "--labels",
-        s(&labels),
-        "--channels",
-        &channels.to_string(),
-        "--rate",
-        &rate.to_string(),
-        "--reference",
+        s(&labels)
+    )));
+    ok(run(&format!(
+        "train {session} -o {model} --model ln --epochs 30 --validation none --seed 2"
+    )));
+    let json = ok(run(&format!(
+        "decode {session} --model {model} -o {decoded} --finger 1 --json"
+    )));
+    let numpy = numpy_agreement(
+        Path::new(decoded),
+        &samples,
         "angle",
-        "--ignore-columns",
-        "time_s",
-        "-o",
-        s(&session),
-    ]));
-    let model = dir.join("m.hsm");
-    ok(handctl(&[
-        "train",
-        s(&session),
-        "-o",
-        s(&model),
-        "--model",
-        "ln",
-        "--epochs",
-        "30",
-        "--validation",
-        "none",
-        "--seed",
-        "2",
-    ]));
-    let decoded = dir.join("decoded.csv");
-    let json = ok(handctl(&[
-        "decode",
-        s(&session),
-        "--model",
-        s(&model),
-        "-o",
-        s(&decoded),
-        "--finger",
-        "1",
-        "--json",
-    ]));
-    let numpy = numpy_agreement(&decoded, &samples, "angle", rate, window_len, "index");
+        rate,
+        window_len,
+        "index",
+    );
     assert_same_figures(&json, &numpy);
     let n = (16.0 * rate) as usize;
     let windows = (n - window_len) / step_len + 1;
@@ -324,143 +272,90 @@ fn four_and_sixteen_channels_at_other_rates() {
 
 #[test]
 fn configurations_that_cannot_work_are_clear_errors() {
-    let dir = tmp("errors");
+    let dir = tmp("import-errors");
     let (samples, labels) = synthesise(&dir, 4, 200.0);
-    let import = |extra: &[&str]| {
-        let mut args = vec![
-            "import",
-            "--samples",
-            s(&samples),
-            "--labels",
-            s(&labels),
-            "--channels",
-            "4",
-            "--rate",
-            "200",
-            "--ignore-columns",
-            "time_s",
-            "-o",
-            s(&dir.join("session")),
-        ];
-        args.extend_from_slice(extra);
-        handctl(&args)
-    };
-    let e = fails(import(&["--reference", "angle", "--band-high", "100"]));
+    let base = format!(
+        "import --samples {} --labels {} --channels 4 --rate 200 --ignore-columns time_s",
+        s(&samples),
+        s(&labels)
+    );
+    let refused = dir.join("refused");
+    let import = |extra: &str| run(&format!("{base} -o {} {extra}", s(&refused)));
+    let e = fails(import("--reference angle --band-high 100"));
     assert!(
         e.contains("band_high_hz = 100") && e.contains("Nyquist"),
         "{e}"
     );
-    let e = fails(import(&["--reference", "angle", "--band-low", "95"]));
+    let e = fails(import("--reference angle --band-low 95"));
     assert!(e.contains("band_low_hz = 95") && e.contains("90 Hz"), "{e}");
-    let e = fails(import(&["--reference", "angel"]));
+    let e = fails(import("--reference angel"));
     assert!(e.contains("\"angel\"") && e.contains("time_s, ch0"), "{e}");
     // Without the reference named, the angle column counts as a fifth channel.
-    let e = fails(import(&[]));
+    let e = fails(import(""));
     assert!(e.contains("leave 5 EMG channels"), "{e}");
-    assert!(!dir.join("session").join("session.toml").exists());
+    assert!(!refused.join("session.toml").exists());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
 
-    // A session without a reference: decoding works, comparing with a reference does not; a
-    // model of another chain is refused naming the difference.
-    let session = dir.join("plain");
+/// A session without a reference: decoding works (the session or its bare samples file alike),
+/// comparing with a reference does not; a model of another chain is refused naming the
+/// difference.
+#[test]
+fn decode_without_a_reference_and_the_errors() {
+    let dir = tmp("decode-errors");
+    let (samples, labels) = synthesise(&dir, 4, 200.0);
     let plain = dir.join("plain.csv");
     let text = std::fs::read_to_string(&samples).unwrap();
-    let mut csv = String::new();
-    for line in text.lines() {
-        csv.push_str(&line[..line.rfind(',').unwrap()]);
-        csv.push('\n');
-    }
-    std::fs::write(&plain, csv).unwrap();
-    ok(handctl(&[
-        "import",
-        "--samples",
+    let lines: Vec<&str> = text.lines().map(|l| &l[..l.rfind(',').unwrap()]).collect();
+    std::fs::write(&plain, lines.join("\n")).unwrap();
+    let base = format!(
+        "import --samples {} --labels {} --channels 4 --rate 200 --ignore-columns time_s",
         s(&plain),
-        "--labels",
-        s(&labels),
-        "--channels",
-        "4",
-        "--rate",
-        "200",
-        "--ignore-columns",
-        "time_s",
-        "-o",
-        s(&session),
-    ]));
-    let model = dir.join("m.hsm");
-    ok(handctl(&[
-        "train",
-        s(&session),
-        "-o",
-        s(&model),
-        "--model",
-        "ln",
-        "--epochs",
-        "2",
-        "--validation",
-        "none",
-    ]));
-    let decoded = dir.join("d.csv");
-    let out = ok(handctl(&[
-        "decode",
-        s(&session),
-        "--model",
-        s(&model),
-        "-o",
-        s(&decoded),
-    ]));
+        s(&labels)
+    );
+    let (session, other) = (dir.join("s"), dir.join("other"));
+    let (session, other) = (s(&session), s(&other));
+    let (model, decoded) = (dir.join("m.hsm"), dir.join("d.csv"));
+    let (model, decoded) = (s(&model), s(&decoded));
+    ok(run(&format!("{base} -o {session}")));
+    ok(run(&format!("{base} -o {other} --band-high 80")));
+    ok(run(&format!(
+        "train {session} -o {model} --model ln --epochs 2 --validation none"
+    )));
+    let out = ok(run(&format!(
+        "decode {session} --model {model} -o {decoded}"
+    )));
     assert!(out.contains("wrote") && !out.contains("R²"), "{out}");
-    let header = std::fs::read_to_string(&decoded).unwrap();
+    let header = std::fs::read_to_string(decoded).unwrap();
     assert!(
         header.starts_with("time_s,thumb,index,middle,ring,pinky\n"),
         "{header}"
     );
-    let e = fails(handctl(&[
-        "decode",
-        s(&session),
-        "--model",
-        s(&model),
-        "-o",
-        s(&decoded),
-        "--finger",
-        "index",
-    ]));
-    assert!(e.contains("no") && e.contains("--reference"), "{e}");
-    let e = fails(handctl(&[
-        "decode",
-        s(&session),
-        "--model",
-        s(&model),
-        "-o",
-        s(&decoded),
-        "--finger",
-        "wrist",
-    ]));
-    assert!(e.contains("wrist") && e.contains("thumb"), "{e}");
-    let other = dir.join("other");
-    ok(handctl(&[
-        "import",
-        "--samples",
+    let decode = |extra: &str| {
+        run(&format!(
+            "decode {session} --model {model} -o {decoded} {extra}"
+        ))
+    };
+    // The session's bare samples file, read with the model's chain, decodes the same; the
+    // source CSV, whose time column would be a fifth channel, is refused.
+    let bare = dir.join("bare.csv");
+    let npy = format!("{session}/samples.npy");
+    ok(run(&format!(
+        "decode {npy} --model {model} -o {}",
+        s(&bare)
+    )));
+    assert_eq!(std::fs::read_to_string(&bare).unwrap(), header);
+    let e = fails(run(&format!(
+        "decode {} --model {model} -o {}",
         s(&plain),
-        "--labels",
-        s(&labels),
-        "--channels",
-        "4",
-        "--rate",
-        "200",
-        "--band-high",
-        "80",
-        "--ignore-columns",
-        "time_s",
-        "-o",
-        s(&other),
-    ]));
-    let e = fails(handctl(&[
-        "decode",
-        s(&other),
-        "--model",
-        s(&model),
-        "-o",
-        s(&decoded),
-    ]));
+        s(&bare)
+    )));
+    assert!(e.contains("leave 5 EMG channels"), "{e}");
+    let e = fails(decode("--finger index"));
+    assert!(e.contains("has none") && e.contains("--reference"), "{e}");
+    let e = fails(decode("--finger wrist"));
+    assert!(e.contains("wrist") && e.contains("thumb"), "{e}");
+    let e = fails(run(&format!("decode {other} --model {model} -o {decoded}")));
     assert!(
         e.contains("signal chain") && e.contains("band_high_hz: 90"),
         "{e}"

@@ -22,6 +22,7 @@ mod reference;
 mod stream;
 mod table_import;
 mod trial;
+mod unlabelled;
 mod windows;
 
 use std::path::{Path, PathBuf};
