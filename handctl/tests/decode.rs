@@ -260,9 +260,9 @@ fn an_8_channel_armband_at_200_hz_imports_trains_and_decodes() {
 
 #[test]
 fn four_and_sixteen_channels_at_other_rates() {
-    // 250 Hz: 50 ms is 12.5 samples, the step is rounded to 12 samples (48 ms), and said.
-    let out = front_end(4, 250.0, 50, 12);
-    assert!(out.contains("chose step 48 ms"), "{out}");
+    // 250 Hz: 50 ms is 12.5 samples, the step is rounded to 13 samples (52 ms), and said.
+    let out = front_end(4, 250.0, 50, 13);
+    assert!(out.contains("chose step 52 ms (13 samples"), "{out}");
     let out = front_end(16, 1000.0, 200, 50);
     assert!(
         !out.contains("chose"),
@@ -322,20 +322,14 @@ fn decode_without_a_reference_and_the_errors() {
     ok(run(&format!(
         "train {session} -o {model} --model ln --epochs 2 --validation none"
     )));
-    let out = ok(run(&format!(
-        "decode {session} --model {model} -o {decoded}"
-    )));
+    let decode = |extra: &str| run(&format!("decode {session} --model {model} {extra}"));
+    let out = ok(decode(&format!("-o {decoded}")));
     assert!(out.contains("wrote") && !out.contains("R²"), "{out}");
-    let header = std::fs::read_to_string(decoded).unwrap();
+    let csv = std::fs::read_to_string(decoded).unwrap();
     assert!(
-        header.starts_with("time_s,thumb,index,middle,ring,pinky\n"),
-        "{header}"
+        csv.starts_with("time_s,thumb,index,middle,ring,pinky\n"),
+        "{csv}"
     );
-    let decode = |extra: &str| {
-        run(&format!(
-            "decode {session} --model {model} -o {decoded} {extra}"
-        ))
-    };
     // The session's bare samples file, read with the model's chain, decodes the same; the
     // source CSV, whose time column would be a fifth channel, is refused.
     let bare = dir.join("bare.csv");
@@ -344,16 +338,16 @@ fn decode_without_a_reference_and_the_errors() {
         "decode {npy} --model {model} -o {}",
         s(&bare)
     )));
-    assert_eq!(std::fs::read_to_string(&bare).unwrap(), header);
+    assert_eq!(std::fs::read_to_string(&bare).unwrap(), csv);
     let e = fails(run(&format!(
         "decode {} --model {model} -o {}",
         s(&plain),
         s(&bare)
     )));
     assert!(e.contains("leave 5 EMG channels"), "{e}");
-    let e = fails(decode("--finger index"));
+    let e = fails(decode(&format!("-o {decoded} --finger index")));
     assert!(e.contains("has none") && e.contains("--reference"), "{e}");
-    let e = fails(decode("--finger wrist"));
+    let e = fails(decode(&format!("-o {decoded} --finger wrist")));
     assert!(e.contains("wrist") && e.contains("thumb"), "{e}");
     let e = fails(run(&format!("decode {other} --model {model} -o {decoded}")));
     assert!(

@@ -5,7 +5,7 @@
 //! * Band-pass upper edge: `min(450 Hz, 0.9 × Nyquist)`, i.e. 450 Hz from 1 kHz up and 90 Hz
 //!   for an armband at 200 Hz (an edge at or above Nyquist cannot be designed).
 //! * Window and step: 200 ms and 50 ms when those are whole numbers of samples at the rate,
-//!   otherwise the nearest whole number of samples (e.g. 48 ms at 250 Hz for the step).
+//!   otherwise the nearest whole number of samples (12.5 samples rounds half away from zero: a 52 ms step at 250 Hz).
 //! * Everything else ([`ChainConfig::default`]): 10 Hz lower edge, 4th order, notch at the mains.
 //!
 //! A configuration that cannot work is refused by [`ChainConfig::validate`]'s clear errors;
@@ -158,8 +158,8 @@ mod tests {
     #[test]
     fn at_250_hz_the_step_is_rounded_to_whole_samples() {
         let c = front_end(16, 250.0).chain().unwrap();
-        assert_eq!((c.settings.window_len(), c.settings.step_len()), (50, 12));
-        assert_eq!(c.config.step_ms, 48.0);
+        assert_eq!((c.settings.window_len(), c.settings.step_len()), (50, 13));
+        assert_eq!(c.config.step_ms, 52.0);
         assert_eq!(c.choices.len(), 2, "{:?}", c.choices);
     }
 

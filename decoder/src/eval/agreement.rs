@@ -51,7 +51,12 @@ pub fn agreement(output: &[f64], reference: &[f64]) -> Result<Agreement, EvalErr
             "reference agreement: fewer than 2 windows".into(),
         ));
     }
-    let fit = linear_fit(output, reference).ok();
+    // Equal values whose mean is not representable would leave rounding-sized deviations and a
+    // meaningless r: constancy is decided on the values themselves.
+    let constant = |v: &[f64]| v.iter().all(|&x| x == v[0]);
+    let fit = (!constant(output))
+        .then(|| linear_fit(output, reference).ok())
+        .flatten();
     let fit_rmse = fit.map(|f| {
         let line: Vec<f64> = output.iter().map(|o| f.slope * o + f.intercept).collect();
         rmse(reference, &line)
@@ -60,7 +65,9 @@ pub fn agreement(output: &[f64], reference: &[f64]) -> Result<Agreement, EvalErr
         n: output.len(),
         r2: r2_or_exact(reference, output),
         rmse: rmse(reference, output),
-        pearson: pearson(output, reference).ok(),
+        pearson: (!constant(output) && !constant(reference))
+            .then(|| pearson(output, reference).ok())
+            .flatten(),
         fit,
         fit_rmse,
     })
@@ -90,6 +97,8 @@ mod tests {
         let a = agreement(&[0.2, 0.2, 0.2], &[1.0, 2.0, 3.0]).unwrap();
         assert_eq!((a.pearson, a.fit, a.fit_rmse), (None, None, None));
         assert!(a.r2 < 0.0);
+        let a = agreement(&[0.1, 0.2, 0.3], &[4.0, 4.0, 4.0]).unwrap();
+        assert_eq!(a.pearson, None);
         assert!(agreement(&[1.0], &[1.0]).is_err());
         assert!(agreement(&[1.0, 2.0], &[1.0]).is_err());
     }
