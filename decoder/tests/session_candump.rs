@@ -85,6 +85,7 @@ fn meta(channels: usize) -> SessionMeta {
             trial(1, TrialKind::Rest, 0, 1500),
             trial(2, TrialKind::Flexion, 1500, 3000),
         ],
+        reference: None,
     }
 }
 

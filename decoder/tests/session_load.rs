@@ -187,6 +187,8 @@ fn csv_and_label_table_import() {
         rows_are_recordings: false,
         full_scale: Some(2047.0),
         onset_skip_ms: 0.0,
+        reference: None,
+        ignore_columns: Vec::new(),
     };
     let out = dir.join("session");
     import_table(&spec, &out).unwrap();

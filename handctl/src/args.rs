@@ -32,6 +32,10 @@ pub enum Command {
     /// Write a session directory from an external recording: samples (NPY or CSV) plus a
     /// label table CSV with the header finger,kind,repetition,start_sample,end_sample.
     Import(ImportArgs),
+    /// Run a model over every window of a session's recording and write, per window, its
+    /// time and the five outputs as CSV; with a reference signal (import --reference), print
+    /// how well the finger's output follows it (R², RMSE, Pearson r).
+    Decode(DecodeArgs),
     /// Show the running daemon's state, faults, latency and per-finger values.
     Status(StatusArgs),
     /// Change one finger's kF and/or kα on the running daemon (saved to its config).
@@ -214,12 +218,34 @@ pub struct ImportArgs {
     /// start_sample, end_sample (exclusive); an id column is optional.
     #[arg(long)]
     pub labels: PathBuf,
-    /// Number of channels in the samples.
+    /// Number of EMG channels in the samples (the columns less --reference and
+    /// --ignore-columns).
     #[arg(long)]
     pub channels: usize,
     /// Sample rate in Hz.
     #[arg(long, default_value_t = 1000.0)]
     pub rate: f64,
+    /// A column holding a reference signal (force, angle) recorded with the EMG, by CSV
+    /// header name or 0-based index: stored with the session for `handctl decode`.
+    #[arg(long)]
+    pub reference: Option<String>,
+    /// Columns that are neither EMG nor the reference (e.g. a time stamp), comma separated,
+    /// by name or index.
+    #[arg(long, value_delimiter = ',')]
+    pub ignore_columns: Vec<String>,
+    /// Lower band-pass edge in Hz (default 10).
+    #[arg(long)]
+    pub band_low: Option<f64>,
+    /// Upper band-pass edge in Hz, below Nyquist (default 450 Hz, or 0.9 x Nyquist when the
+    /// rate is under 1 kHz: 90 Hz at 200 Hz).
+    #[arg(long)]
+    pub band_high: Option<f64>,
+    /// Feature window in ms, a whole number of samples (default 200, rounded to whole samples).
+    #[arg(long)]
+    pub window_ms: Option<f64>,
+    /// Step between feature windows in ms (default 50, rounded to whole samples).
+    #[arg(long)]
+    pub step_ms: Option<f64>,
     /// Mains frequency to notch, 50 or 60 Hz.
     #[arg(long, default_value_t = 50)]
     pub mains: u32,
@@ -280,4 +306,26 @@ fn parse_mains(s: &str) -> Result<u32, String> {
         "60" => Ok(60),
         _ => Err(format!("{s:?}: mains is 50 or 60 Hz")),
     }
+}
+
+/// `handctl decode`.
+#[derive(Debug, Args)]
+pub struct DecodeArgs {
+    /// Session directory (or 3dc:DIR:train|test) whose whole recording is decoded; or a bare
+    /// recording file, read with the model's channels and rate: a candump log (.log) or
+    /// samples (.npy, .csv, every column a channel).
+    pub session: String,
+    /// Model file (trained on the same signal chain as the session's).
+    #[arg(long)]
+    pub model: PathBuf,
+    /// CSV to write: time_s, the five outputs, and the reference (mean over each window).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// The finger whose output is compared with the reference (0-4 or a name; default: every
+    /// finger). Needs a session with a reference signal.
+    #[arg(long)]
+    pub finger: Option<String>,
+    /// Print the agreement as JSON (exact numbers) instead of a table.
+    #[arg(long)]
+    pub json: bool,
 }

@@ -1,5 +1,5 @@
 //! `handctl`, the technician's command line for the hand: calibration training, evaluation,
-//! importing recordings, the running daemon's status, live tuning, arm and stop, and the demo
+//! importing recordings, decoding them, the running daemon's status, live tuning, arm and stop, and the demo
 //! (with the `sim` feature). One module per subcommand, the argument structures in `args`.
 //!
 //! A crate of its own, beside the daemon's (`driver`): what only the technician's tool needs
@@ -11,6 +11,7 @@
 
 mod args;
 mod daemon;
+mod decode;
 #[cfg(feature = "sim")]
 mod demo;
 mod error;
@@ -38,6 +39,7 @@ fn main() -> ExitCode {
         Command::Check(a) => train::run_check(a),
         Command::Verify(a) => verify::run(a),
         Command::Import(a) => import::run_table(a),
+        Command::Decode(a) => decode::run(a),
         Command::Status(a) => daemon::status(&a.daemon, a.json),
         Command::Tune(a) => daemon::tune(a),
         Command::Arm(o) => daemon::arm(o),

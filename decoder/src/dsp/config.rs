@@ -153,6 +153,15 @@ pub enum ConfigError {
         /// What is wrong.
         why: &'static str,
     },
+    /// The configuration failed with defaults chosen for the front end's rate
+    /// ([`super::FrontEnd`]); the message names them.
+    #[error("{source} (defaults chosen for this front end: {chosen})")]
+    WithDefaults {
+        /// The defaults chosen, in words.
+        chosen: String,
+        /// Why the configuration was refused.
+        source: Box<ConfigError>,
+    },
 }
 
 /// Converts a duration in ms to a whole number of samples, or says why it is not one.

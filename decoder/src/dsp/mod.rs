@@ -60,6 +60,7 @@ mod config;
 mod design;
 mod faults;
 mod features;
+mod front_end;
 pub mod npy;
 mod sos;
 
@@ -71,4 +72,5 @@ pub use config::{
 pub use design::{butter_bandpass, dc_highpass, iirnotch};
 pub use faults::{Faults, MAX_ABS_SAMPLE};
 pub use features::{window_features, FEATURES_PER_CHANNEL, FEATURE_NAMES};
+pub use front_end::{default_band_high_hz, FrontEnd, FrontEndChain, NYQUIST_FRACTION};
 pub use sos::Sos;

@@ -1,11 +1,13 @@
 //! Offline evaluation as in the paper: direction AUC with the Hanley-McNeil standard error and
 //! sign accuracy (Table 3), the interpolation analysis (Table 4), tracking metrics (RMSE, MAPE,
-//! R²), text tables, the curves as CSV and (with the `plots` feature) PNG figures.
+//! R²), decoding a recording and its agreement with a reference signal, text tables, the curves as CSV and (with the `plots` feature) PNG figures.
 //!
 //! The metric functions take plain slices and a prediction closure, so they know nothing of
 //! how a model was built; [`evaluate_model`] ties them to trained models and calibration sessions.
 
+mod agreement;
 mod csv;
+mod decode;
 mod direction;
 mod error;
 mod evaluate;
@@ -16,7 +18,9 @@ mod stats;
 mod table;
 mod tracking;
 
+pub use agreement::{agreement, Agreement};
 pub use csv::{interpolation_csv, roc_csv, write_csv};
+pub use decode::{decode, Decoded};
 pub use direction::{
     auc, direction_metrics, hanley_mcneil_se, roc_curve, sign_accuracy, DirectionMetrics, RocPoint,
 };

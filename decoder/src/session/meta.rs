@@ -32,6 +32,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use super::error::SessionError;
+use super::reference::ReferenceSpec;
 use super::trial::{FingerField, Trial, TrialKind, N_FINGERS};
 use crate::dsp::ChainConfig;
 use crate::fsio::write_atomic;
@@ -89,6 +90,8 @@ pub struct SessionMeta {
     pub segments: Vec<Segment>,
     /// The trials, in file order.
     pub trials: Vec<Trial>,
+    /// A force or angle recorded beside the EMG, if the import named one.
+    pub reference: Option<ReferenceSpec>,
 }
 
 #[derive(Debug, Serialize, Deserialize)]
@@ -116,6 +119,8 @@ struct SessionFile {
     onset_skip_ms: f64,
     chain: ChainConfig,
     recording: RecordingSpec,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    reference: Option<ReferenceSpec>,
     #[serde(default, rename = "segment", skip_serializing_if = "Vec::is_empty")]
     segments: Vec<Segment>,
     #[serde(default, rename = "trial")]
@@ -146,6 +151,7 @@ impl SessionMeta {
             },
             segments: Vec::new(),
             trials,
+            reference: None,
         }
     }
 
@@ -195,6 +201,7 @@ impl SessionMeta {
             recording: file.recording,
             segments: file.segments,
             trials,
+            reference: file.reference,
         };
         meta.check(path)?;
         Ok(meta)
@@ -281,6 +288,7 @@ impl SessionMeta {
             onset_skip_ms: self.onset_skip_ms,
             chain: self.chain.clone(),
             recording: self.recording.clone(),
+            reference: self.reference.clone(),
             segments: self.segments.clone(),
             trials: self
                 .trials

@@ -5,9 +5,12 @@
 //! Targets per window: the trial's finger +1 (flexion) or -1 (extension), all five 0 for rest;
 //! fingers a trial does not involve are masked out. Whole-hand trials (`finger = "all"`) set all
 //! five. Importers turn external recordings (NPY or CSV plus a label table, and the 3DC armband
-//! recordings as a proxy) into the same form.
+//! recordings as a proxy) into the same form; an imported session may carry a reference signal
+//! (a force or angle column, [`Reference`]). [`Session::stream_windows`] gives every window of
+//! the recording, labelled or not, for decoding.
 
 mod candump;
+mod columns;
 mod error;
 mod gates;
 mod import;
@@ -15,20 +18,25 @@ mod load;
 mod meta;
 mod npy;
 mod recording;
+mod reference;
+mod stream;
+mod table_import;
 mod trial;
+mod unlabelled;
 mod windows;
 
 use std::path::{Path, PathBuf};
 
+pub use columns::{SampleTable, SplitColumns};
 pub use error::SessionError;
 pub use gates::{check_gates, GateConfig, GateIssue, GateKind, GateReport};
-pub use import::{
-    import_3dc, import_table, load_3dc, load_label_table, parse_session_spec, SamplesSource,
-    SessionSpec, Split, TableImport,
-};
+pub use import::{import_3dc, load_3dc, parse_session_spec, SessionSpec, Split};
 pub use meta::{RecordingFormat, RecordingSpec, Segment, SessionMeta, FORMAT_VERSION, META_FILE};
 pub use npy::{npy_f64_bytes, write_npy_f64};
 pub use recording::Recording;
+pub use reference::{Reference, ReferenceSpec, REFERENCE_FILE};
+pub use stream::StreamWindows;
+pub use table_import::{import_table, load_label_table, SamplesSource, TableImport};
 pub use trial::{Trial, TrialKind, TrialTable, FINGER_NAMES, N_FINGERS};
 pub use windows::{LabelledWindows, WindowLabel, WindowOptions};
 
@@ -41,6 +49,8 @@ pub struct Session {
     pub meta: SessionMeta,
     /// The raw signal.
     pub recording: Recording,
+    /// The force or angle recorded beside it, if the session has one (one value per sample).
+    pub reference: Option<Reference>,
 }
 
 impl Session {
@@ -54,10 +64,13 @@ impl Session {
         }
         let meta = SessionMeta::read(dir)?;
         let recording = Recording::load(&meta, dir)?;
-        Self::from_parts(dir.to_path_buf(), meta, recording)
+        let reference = Reference::load(&meta, dir, recording.len())?;
+        let mut session = Self::from_parts(dir.to_path_buf(), meta, recording)?;
+        session.reference = reference;
+        Ok(session)
     }
 
-    /// Builds a session from parts, checking that they agree.
+    /// Builds a session from parts, checking that they agree (no reference signal).
     pub fn from_parts(
         name: PathBuf,
         meta: SessionMeta,
@@ -89,6 +102,7 @@ impl Session {
             name,
             meta,
             recording,
+            reference: None,
         })
     }
 
