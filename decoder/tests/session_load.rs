@@ -42,7 +42,12 @@ fn windows_carry_targets_and_masks() {
         assert!(l.end_sample - 200 >= start && l.end_sample <= end);
     }
     // Two-point mode leaves rest out.
-    let w2 = s.windows(&WindowOptions { two_point: true }).unwrap();
+    let w2 = s
+        .windows(&WindowOptions {
+            two_point: true,
+            ..WindowOptions::default()
+        })
+        .unwrap();
     assert_eq!(w2.len(), w.len() - 2 * 37);
     assert!(w2
         .labels

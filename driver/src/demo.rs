@@ -191,7 +191,7 @@ pub fn run_demo(
         "training ResDD on the calibration session",
     ));
     let data = session
-        .windows(&WindowOptions { two_point: false })?
+        .windows(&WindowOptions::default())?
         .to_dataset(&session.meta.chain)?;
     let cfg = TrainConfig {
         max_epochs: opts.max_epochs,

@@ -4,6 +4,7 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
+use super::effort::EffortPenalty;
 use super::error::TrainError;
 
 /// Gradient step rule.
@@ -179,6 +180,11 @@ pub struct TrainConfig {
     pub split: ValidationSplit,
     /// Seed for initialisation, split and shuffling (default 0).
     pub seed: u64,
+    /// The effort-ray penalty that keeps the decoder monotonic in effort (default on; `None`
+    /// is the paper's plain training, and what a model file without the field was trained
+    /// with).
+    #[serde(default)]
+    pub effort: Option<EffortPenalty>,
 }
 
 impl Default for TrainConfig {
@@ -191,6 +197,17 @@ impl Default for TrainConfig {
             min_delta: 1e-6,
             split: ValidationSplit::default(),
             seed: 0,
+            effort: Some(EffortPenalty::default()),
+        }
+    }
+}
+
+impl TrainConfig {
+    /// The paper's plain training: the defaults without the effort-ray penalty.
+    pub fn plain() -> Self {
+        TrainConfig {
+            effort: None,
+            ..TrainConfig::default()
         }
     }
 }
@@ -199,6 +216,9 @@ impl TrainConfig {
     /// Checks every field; the error names the field and its allowed range.
     pub fn validate(&self) -> Result<(), TrainError> {
         self.optimizer.validate()?;
+        if let Some(effort) = &self.effort {
+            effort.validate()?;
+        }
         let bad = |m: String| Err(TrainError::Config(m));
         if self.batch_size == 0 || self.batch_size > 1 << 20 {
             return bad(format!(
