@@ -12,7 +12,9 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use decoder::eval::tracking_metrics;
-use decoder::model::{train, EpochReport, ModelKind, ModelSpec, TrainConfig, TrainedModel};
+use decoder::model::{
+    train, EpochReport, ModelKind, ModelSpec, TrainConfig, TrainedModel, N_FINGERS,
+};
 use decoder::session::{check_gates, GateConfig, Session, WindowOptions};
 use hand_clock::{Clock, SystemClock, VirtualClock};
 use hand_dbc::candump::LogWriter;
@@ -81,6 +83,10 @@ pub struct DemoReport {
     pub mape: Option<f64>,
     /// Coefficient of determination.
     pub r2: f64,
+    /// Selectivity: per finger (0 thumb .. 4 pinky), the mean |label| the decoder gave it over
+    /// the scored samples, while only the index finger moves (the other fingers should stay
+    /// near 0).
+    pub mean_abs_label: [f64; N_FINGERS],
     /// The daemon's snapshot at the end (latency, deadline misses, ...).
     pub end: Snapshot,
 }
@@ -218,8 +224,11 @@ pub fn run_demo(
     };
     let skip = (opts.settle_s * 50.0) as usize;
     let scored = samples.get(skip..).unwrap_or(&[]);
-    let target: Vec<f64> = scored.iter().map(|s| s.0).collect();
-    let tracked: Vec<f64> = scored.iter().map(|s| s.1).collect();
+    let target: Vec<f64> = scored.iter().map(|s| s.target).collect();
+    let tracked: Vec<f64> = scored.iter().map(|s| s.tracked).collect();
+    let n = scored.len().max(1) as f64;
+    let mean_abs_label: [f64; N_FINGERS] =
+        std::array::from_fn(|f| scored.iter().map(|s| s.labels[f].abs()).sum::<f64>() / n);
     let m = tracking_metrics(&target, &tracked)?;
     let s = model.summary();
     Ok(DemoReport {
@@ -232,6 +241,7 @@ pub fn run_demo(
         rmse: m.rmse,
         mape: m.mape,
         r2: m.r2,
+        mean_abs_label,
         end,
     })
 }
@@ -247,14 +257,24 @@ impl DemoClock for VirtualClock {
 }
 impl DemoClock for SystemClock {}
 
-/// Runs the closed loop; returns (target, tracked) at every index FINGER_STATUS.
+/// One scored moment: at an index FINGER_STATUS.
+struct TrackSample {
+    /// The sine's target.
+    target: f64,
+    /// The index finger's force / full scale.
+    tracked: f64,
+    /// The decoder's raw label of every finger (before conditioning), from the snapshot.
+    labels: [f64; N_FINGERS],
+}
+
+/// Runs the closed loop; returns a sample at every index FINGER_STATUS.
 fn track<K: DemoClock>(
     model: &TrainedModel,
     opts: &DemoOptions,
     clock: K,
     virtual_time: bool,
     on: &mut impl FnMut(DemoEvent<'_>),
-) -> Result<(Vec<(f64, f64)>, Snapshot), DemoError> {
+) -> Result<(Vec<TrackSample>, Snapshot), DemoError> {
     let tracking = TrackingConfig {
         seed: opts.seed,
         ..TrackingConfig::default()
@@ -318,7 +338,12 @@ fn track<K: DemoClock>(
                 if let Ok(st) = FingerStatus::decode(id, r.frame.data()) {
                     let t = r.time_us.unwrap_or(now).saturating_sub(start);
                     tracked = st.force() / tracking.full_scale_force_n;
-                    samples.push((tracking.target.at(t), tracked));
+                    let snap = *runner.snapshot().lock().unwrap_or_else(|e| e.into_inner());
+                    samples.push(TrackSample {
+                        target: tracking.target.at(t),
+                        tracked,
+                        labels: snap.labels,
+                    });
                 }
             }
         }

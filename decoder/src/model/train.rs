@@ -37,7 +37,8 @@ pub struct EpochReport {
     /// The effort-ray penalty per unmasked target during this epoch, unweighted (None
     /// without the penalty).
     pub effort_penalty: Option<f64>,
-    /// Masked MSE on the held-out windows after this epoch (None without a split).
+    /// Masked MSE on the held-out windows after this epoch, plus the weighted effort penalty
+    /// there when it is on (None without a split).
     pub val_loss: Option<f64>,
     /// Epoch with the best validation loss so far (the current one without a split).
     pub best_epoch: usize,
@@ -167,6 +168,43 @@ fn masked_mse(model: &AnyModel, set: &Normalized<'_>, idx: &[usize], scratch: &m
     } else {
         sum / count as f64
     }
+}
+
+/// The objective on the held-out windows `idx`: masked MSE, plus with the effort penalty its
+/// weighted value per unmasked target at the strata's midpoints (fixed efforts, so epochs are
+/// compared on the same points).
+fn validation_loss(
+    model: &AnyModel,
+    set: &Normalized<'_>,
+    idx: &[usize],
+    ws: &mut Workspace,
+) -> f64 {
+    let mse = masked_mse(model, set, idx, &mut ws.scratch);
+    let Some(e) = ws.effort.as_mut() else {
+        return mse;
+    };
+    e.jitter.fill(0.5);
+    e.cfg.efforts(&e.jitter, &mut e.ks);
+    let (mut penalty, mut count) = (0.0, 0usize);
+    for &i in idx {
+        let (t, m) = (set.data.target(i), set.data.mask(i));
+        count += m.iter().filter(|&&b| b).count();
+        let dirs = ray_directions(t, m);
+        if dirs.iter().any(|&d| d != 0.0) {
+            let (x, ks) = (set.x(i), &e.ks);
+            penalty += ray_penalty(
+                model,
+                x,
+                &dirs,
+                ks,
+                e.cfg.min_slope,
+                &mut e.ray,
+                &mut ws.scratch,
+                None,
+            );
+        }
+    }
+    mse + e.cfg.weight * penalty / count.max(1) as f64
 }
 
 fn distinct_trials(data: &Dataset, idx: &[usize]) -> usize {
@@ -301,7 +339,7 @@ fn run_epochs(
             return Err(TrainError::Diverged { epoch });
         }
         let val_loss = if has_val {
-            let v = masked_mse(model, set, &split.val, &mut ws.scratch);
+            let v = validation_loss(model, set, &split.val, &mut ws);
             if !v.is_finite() {
                 return Err(TrainError::Diverged { epoch });
             }

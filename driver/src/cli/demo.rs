@@ -86,6 +86,13 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
         report.mape.map_or("n/a".into(), |m| format!("{m:.1}%")),
         report.r2
     );
+    let others: Vec<String> = (0..5)
+        .map(|f| format!("{} {:.3}", FINGER_NAMES[f], report.mean_abs_label[f]))
+        .collect();
+    println!(
+        "selectivity (mean |label| per finger while the index tracks; others should stay near 0): {}",
+        others.join(", ")
+    );
     println!(
         "daemon: latency p50 {} us p99 {} us, compute p50 {} us p99 {} us, deadline misses {}, state {}",
         report.end.latency.p50_us,
