@@ -47,6 +47,11 @@ pub struct DemoOptions {
     pub work_dir: PathBuf,
     /// Training epochs at most.
     pub max_epochs: usize,
+    /// The paper's plain training, without the effort-ray penalty.
+    pub plain: bool,
+    /// The paper's labels: the fingers a single-finger trial does not move are masked out of
+    /// the loss instead of trained toward 0.
+    pub mask_others: bool,
 }
 
 impl Default for DemoOptions {
@@ -58,6 +63,8 @@ impl Default for DemoOptions {
             settle_s: 4.0,
             work_dir: std::env::temp_dir().join("handstack-demo"),
             max_epochs: 200,
+            plain: false,
+            mask_others: false,
         }
     }
 }
@@ -197,12 +204,20 @@ pub fn run_demo(
         "training ResDD on the calibration session",
     ));
     let data = session
-        .windows(&WindowOptions::default())?
+        .windows(&WindowOptions {
+            mask_others: opts.mask_others,
+            ..WindowOptions::default()
+        })?
         .to_dataset(&session.meta.chain)?;
+    let base = if opts.plain {
+        TrainConfig::plain()
+    } else {
+        TrainConfig::default()
+    };
     let cfg = TrainConfig {
         max_epochs: opts.max_epochs,
         seed: opts.seed,
-        ..TrainConfig::default()
+        ..base
     };
     let model = train(
         ModelKind::ResDd,

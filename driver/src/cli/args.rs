@@ -100,6 +100,12 @@ pub struct DemoArgs {
     /// Where the calibration session and the model are written (default: a temp directory).
     #[arg(long)]
     pub dir: Option<PathBuf>,
+    /// The paper's plain training, without the effort-ray penalty.
+    #[arg(long)]
+    pub plain: bool,
+    /// The paper's labels: fingers a single-finger trial does not move are left out of the loss.
+    #[arg(long)]
+    pub paper_masks: bool,
 }
 
 fn parse_seconds(s: &str) -> Result<f64, String> {

@@ -22,6 +22,8 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
             .dir
             .clone()
             .unwrap_or_else(|| std::env::temp_dir().join("handstack-demo")),
+        plain: a.plain,
+        mask_others: a.paper_masks,
         ..DemoOptions::default()
     };
     let tty = std::io::stdout().is_terminal();
