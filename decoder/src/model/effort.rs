@@ -26,21 +26,21 @@ use crate::eval::scale_features;
 /// Settings of the effort-ray penalty.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct EffortPenalty {
-    /// Weight of the penalty against the mean squared error (default 1).
+    /// Weight of the penalty against the mean squared error (default 30).
     pub weight: f64,
     /// Jittered efforts per ray between 0 and 1, besides both ends (default 6).
     pub points: usize,
     /// Slope in the trial's direction below which an interval is charged, label units per unit
-    /// of effort; the ideal `y = s·k` has slope 1 (default 0.1).
+    /// of effort; the ideal `y = s·k` has slope 1 (default 0.3).
     pub min_slope: f64,
 }
 
 impl Default for EffortPenalty {
     fn default() -> Self {
         EffortPenalty {
-            weight: 1.0,
+            weight: 30.0,
             points: 6,
-            min_slope: 0.1,
+            min_slope: 0.3,
         }
     }
 }

@@ -45,13 +45,6 @@ pub(super) fn fit(
     } else {
         TrainConfig::default()
     };
-    let mut base = base;
-    if let (Some(e), Ok(v)) = (base.effort.as_mut(), std::env::var("TUNE_EFFORT")) {
-        let f: Vec<f64> = v.split(',').map(|x| x.parse().unwrap()).collect();
-        e.weight = f[0];
-        e.points = f[1] as usize;
-        e.min_slope = f[2];
-    }
     let cfg = TrainConfig {
         max_epochs: opts.epochs,
         seed: opts.seed,
