@@ -210,9 +210,7 @@ impl TrainConfig {
             ..TrainConfig::default()
         }
     }
-}
 
-impl TrainConfig {
     /// Checks every field; the error names the field and its allowed range.
     pub fn validate(&self) -> Result<(), TrainError> {
         self.optimizer.validate()?;
@@ -252,6 +250,55 @@ impl TrainConfig {
                 ))
             }
             _ => Ok(()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_config_without_the_effort_field_is_the_plain_training() {
+        let mut json = serde_json::to_value(TrainConfig::default()).expect("serialise");
+        assert!(json["effort"].is_object(), "{json}");
+        json.as_object_mut().expect("object").remove("effort");
+        let old: TrainConfig = serde_json::from_value(json).expect("old files still load");
+        assert_eq!(old, TrainConfig::plain());
+        assert_ne!(old, TrainConfig::default());
+    }
+
+    #[test]
+    fn bad_effort_settings_are_refused_by_name() {
+        for (bad, field) in [
+            (
+                EffortPenalty {
+                    weight: 0.0,
+                    ..EffortPenalty::default()
+                },
+                "weight",
+            ),
+            (
+                EffortPenalty {
+                    points: 0,
+                    ..EffortPenalty::default()
+                },
+                "points",
+            ),
+            (
+                EffortPenalty {
+                    min_slope: 1.5,
+                    ..EffortPenalty::default()
+                },
+                "min_slope",
+            ),
+        ] {
+            let cfg = TrainConfig {
+                effort: Some(bad),
+                ..TrainConfig::default()
+            };
+            let err = cfg.validate().expect_err("refused").to_string();
+            assert!(err.contains(field), "{err}");
         }
     }
 }
