@@ -26,7 +26,9 @@ use crate::eval::scale_features;
 /// Settings of the effort-ray penalty.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct EffortPenalty {
-    /// Weight of the penalty against the mean squared error (default 30).
+    /// Weight of the penalty against the mean squared error (default 30, tuned with Adam,
+    /// whose step does not grow with the gradient; with SGD the weight multiplies the step, so
+    /// use a weight near 1 there).
     pub weight: f64,
     /// Jittered efforts per ray between 0 and 1, besides both ends (default 6).
     pub points: usize,
