@@ -184,6 +184,37 @@ pub fn record_calibration(dir: &Path, seed: u64) -> Result<usize, DemoError> {
     Ok(run.trials.len())
 }
 
+/// Trains ResDD on the calibration session with the demo's label and training options.
+fn train_resdd(
+    session: &Session,
+    opts: &DemoOptions,
+    on: &mut impl FnMut(DemoEvent<'_>),
+) -> Result<TrainedModel, DemoError> {
+    let data = session
+        .windows(&WindowOptions {
+            mask_others: opts.mask_others,
+            ..WindowOptions::default()
+        })?
+        .to_dataset(&session.meta.chain)?;
+    let base = if opts.plain {
+        TrainConfig::plain()
+    } else {
+        TrainConfig::default()
+    };
+    let cfg = TrainConfig {
+        max_epochs: opts.max_epochs,
+        seed: opts.seed,
+        ..base
+    };
+    Ok(train(
+        ModelKind::ResDd,
+        &ModelSpec::default(),
+        &data,
+        &cfg,
+        &mut |r| on(DemoEvent::Epoch(r)),
+    )?)
+}
+
 /// Calibrate, train, track; see the module docs.
 pub fn run_demo(
     opts: &DemoOptions,
@@ -203,29 +234,7 @@ pub fn run_demo(
     on(DemoEvent::Phase(
         "training ResDD on the calibration session",
     ));
-    let data = session
-        .windows(&WindowOptions {
-            mask_others: opts.mask_others,
-            ..WindowOptions::default()
-        })?
-        .to_dataset(&session.meta.chain)?;
-    let base = if opts.plain {
-        TrainConfig::plain()
-    } else {
-        TrainConfig::default()
-    };
-    let cfg = TrainConfig {
-        max_epochs: opts.max_epochs,
-        seed: opts.seed,
-        ..base
-    };
-    let model = train(
-        ModelKind::ResDd,
-        &ModelSpec::default(),
-        &data,
-        &cfg,
-        &mut |r| on(DemoEvent::Epoch(r)),
-    )?;
+    let model = train_resdd(&session, opts, &mut on)?;
     let model_path = opts.work_dir.join("model.hsm");
     model.save(&model_path)?;
 

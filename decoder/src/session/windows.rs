@@ -17,6 +17,18 @@ pub struct WindowOptions {
     pub mask_others: bool,
 }
 
+impl WindowOptions {
+    /// The loss mask of a trial's windows: all five fingers, or with
+    /// [`WindowOptions::mask_others`] the fingers the trial moves.
+    pub fn mask(&self, trial: &super::Trial) -> [bool; N_FINGERS] {
+        if self.mask_others {
+            trial.involved()
+        } else {
+            [true; N_FINGERS]
+        }
+    }
+}
+
 /// The label of one window.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WindowLabel {
@@ -124,11 +136,7 @@ impl Session {
                 out.labels.push(WindowLabel {
                     trial: *ti,
                     targets: t.targets(),
-                    mask: if opts.mask_others {
-                        t.involved()
-                    } else {
-                        [true; N_FINGERS]
-                    },
+                    mask: opts.mask(t),
                     end_sample: end,
                 });
             }

@@ -88,13 +88,7 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
         report.mape.map_or("n/a".into(), |m| format!("{m:.1}%")),
         report.r2
     );
-    let others: Vec<String> = (0..5)
-        .map(|f| format!("{} {:.3}", FINGER_NAMES[f], report.mean_abs_label[f]))
-        .collect();
-    println!(
-        "selectivity (mean |label| per finger while the index tracks; others should stay near 0): {}",
-        others.join(", ")
-    );
+    println!("{}", selectivity(&report.mean_abs_label));
     println!(
         "daemon: latency p50 {} us p99 {} us, compute p50 {} us p99 {} us, deadline misses {}, state {}",
         report.end.latency.p50_us,
@@ -105,4 +99,15 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
         report.end.state
     );
     Ok(())
+}
+
+/// The selectivity line: the mean |label| of every finger while the index tracks.
+fn selectivity(mean_abs_label: &[f64; 5]) -> String {
+    let fingers: Vec<String> = (0..5)
+        .map(|f| format!("{} {:.3}", FINGER_NAMES[f], mean_abs_label[f]))
+        .collect();
+    format!(
+        "selectivity (mean |label| per finger while the index tracks; others should stay near 0): {}",
+        fingers.join(", ")
+    )
 }
