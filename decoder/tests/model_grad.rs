@@ -1,8 +1,8 @@
 //! Analytic gradients of every architecture against central finite differences.
 
 use decoder::model::{
-    AnyModel, CnnSpec, LnSpec, MlpSpec, Model, ModelKind, ModelSpec, ResDdSpec, ResDdVariant,
-    Trainable,
+    ray_penalty, AnyModel, CnnSpec, EffortPenalty, LnSpec, MlpSpec, Model, ModelKind, ModelSpec,
+    RayWork, ResDdSpec, ResDdVariant, Trainable, N_FINGERS,
 };
 
 /// Small deterministic generator (SplitMix64) so the test needs no RNG crate.
@@ -135,5 +135,81 @@ fn default_sized_models_gradients() {
     for kind in ModelKind::ALL {
         let m = AnyModel::random(kind, &ModelSpec::default(), 96, 5, 1).expect("model");
         check(m, 42);
+    }
+}
+
+/// The effort-ray penalty's analytic gradient against central differences, for every kind:
+/// a window of non-negative features, three fingers with a direction, jittered efforts, and a
+/// slope margin high enough that most intervals are charged.
+fn check_effort_penalty(mut m: AnyModel, seed: u64) {
+    let mut g = Gen(seed);
+    let x: Vec<f64> = (0..m.n_inputs()).map(|_| g.next().abs()).collect();
+    let dirs: [f64; N_FINGERS] = [1.0, -1.0, 0.0, 1.0, 0.0];
+    let cfg = EffortPenalty {
+        points: 5,
+        min_slope: 1.0,
+        ..EffortPenalty::default()
+    };
+    let jitter: Vec<f64> = (0..cfg.points).map(|_| 0.5 * (g.next() + 1.0)).collect();
+    let mut ks = vec![0.0; cfg.points + 2];
+    cfg.efforts(&jitter, &mut ks);
+    assert!(
+        ks.windows(2).all(|w| w[0] < w[1]),
+        "ascending efforts {ks:?}"
+    );
+    let mut work = RayWork::new(m.n_inputs(), ks.len());
+    let mut s = m.new_scratch();
+    let mut grad = vec![0.0; m.params().len()];
+    let scale = 0.7;
+    let p = ray_penalty(
+        &m,
+        &x,
+        &dirs,
+        &ks,
+        cfg.min_slope,
+        &mut work,
+        &mut s,
+        Some((&mut grad, scale)),
+    );
+    assert!(p > 0.0, "the margin charges some interval: {p}");
+    let mut penalty =
+        |m: &AnyModel| ray_penalty(m, &x, &dirs, &ks, cfg.min_slope, &mut work, &mut s, None);
+    assert_eq!(
+        penalty(&m),
+        p,
+        "with or without the gradient, the same penalty"
+    );
+    let n = m.params().len();
+    let stride = (n / 500).max(1);
+    for i in (0..n).step_by(stride) {
+        let p0 = m.params()[i];
+        let h = 1e-6 * (1.0 + p0.abs());
+        m.params_mut()[i] = p0 + h;
+        let lp = penalty(&m);
+        m.params_mut()[i] = p0 - h;
+        let lm = penalty(&m);
+        m.params_mut()[i] = p0;
+        let num = scale * (lp - lm) / (2.0 * h);
+        let diff = (num - grad[i]).abs();
+        assert!(
+            diff <= 1e-7 + 1e-5 * num.abs().max(grad[i].abs()),
+            "{} param {i}: analytic {} numeric {num}",
+            m.kind(),
+            grad[i]
+        );
+    }
+}
+
+#[test]
+fn effort_penalty_gradients() {
+    for kind in ModelKind::ALL {
+        let mut m = AnyModel::random(kind, &spec(), 16, 5, 7).expect("model");
+        // Larger ResDD weights so the multiplicative terms matter; non-zero biases so no ReLU
+        // sits on its kink at k = 0 (where finite differences see a one-sided slope).
+        let mut g = Gen(61);
+        for p in m.params_mut() {
+            *p = 2.0 * *p + 0.1 * g.next();
+        }
+        check_effort_penalty(m, 60);
     }
 }

@@ -3,8 +3,8 @@
 mod model_support;
 
 use decoder::model::{
-    train, CnnSpec, Dataset, EpochReport, LnSpec, MlpSpec, Model, ModelKind, ModelSpec, Optimizer,
-    ResDdSpec, TrainConfig, TrainError, Trainable, ValidationSplit,
+    train, CnnSpec, Dataset, EffortPenalty, EpochReport, LnSpec, MlpSpec, Model, ModelKind,
+    ModelSpec, Optimizer, ResDdSpec, TrainConfig, TrainError, Trainable, ValidationSplit,
 };
 use model_support::{calibration, chain};
 
@@ -151,9 +151,15 @@ fn progress_reports_every_epoch_and_early_stopping_keeps_the_best() {
 #[test]
 fn sgd_window_split_and_no_split_train() {
     let data = calibration(2, 1, 10, 4);
+    // SGD's step is not scale-free like Adam's: the penalty's default weight (tuned with Adam)
+    // would multiply its step 30-fold, so SGD runs with weight 1.
     let sgd = TrainConfig {
         optimizer: Optimizer::sgd(),
         split: ValidationSplit::Window { fraction: 0.25 },
+        effort: Some(EffortPenalty {
+            weight: 1.0,
+            ..EffortPenalty::default()
+        }),
         ..quick(30)
     };
     let m = train(ModelKind::Ln, &small_spec(), &data, &sgd, &mut |_| {}).expect("sgd trains");

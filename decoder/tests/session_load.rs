@@ -32,8 +32,9 @@ fn windows_carry_targets_and_masks() {
             (k, Some(f)) => {
                 let want = if k == TrialKind::Flexion { 1.0 } else { -1.0 };
                 assert_eq!(l.targets[f], want);
-                assert_eq!(l.mask.iter().filter(|&&m| m).count(), 1);
-                assert!(l.mask[f]);
+                // Selective labels: the other fingers are trained toward 0.
+                assert_eq!(l.mask, [true; 5]);
+                assert!((0..5).filter(|&o| o != f).all(|o| l.targets[o] == 0.0));
             }
             (_, None) => unreachable!("the protocol has no whole-hand contraction"),
         }
@@ -41,8 +42,30 @@ fn windows_carry_targets_and_masks() {
         let end = (t.end_us / 1000) as usize;
         assert!(l.end_sample - 200 >= start && l.end_sample <= end);
     }
+    // The paper's masks: a single-finger trial counts for its finger alone.
+    let paper = s
+        .windows(&WindowOptions {
+            mask_others: true,
+            ..WindowOptions::default()
+        })
+        .unwrap();
+    assert_eq!(paper.len(), w.len());
+    for (l, p) in w.labels.iter().zip(&paper.labels) {
+        assert_eq!(l.targets, p.targets);
+        let t = &meta.trials[l.trial];
+        let counted = p.mask.iter().filter(|&&m| m).count();
+        match t.finger {
+            Some(f) if t.kind != TrialKind::Rest => assert!(counted == 1 && p.mask[f]),
+            _ => assert_eq!(counted, 5),
+        }
+    }
     // Two-point mode leaves rest out.
-    let w2 = s.windows(&WindowOptions { two_point: true }).unwrap();
+    let w2 = s
+        .windows(&WindowOptions {
+            two_point: true,
+            ..WindowOptions::default()
+        })
+        .unwrap();
     assert_eq!(w2.len(), w.len() - 2 * 37);
     assert!(w2
         .labels

@@ -12,7 +12,9 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use decoder::eval::tracking_metrics;
-use decoder::model::{train, EpochReport, ModelKind, ModelSpec, TrainConfig, TrainedModel};
+use decoder::model::{
+    train, EpochReport, ModelKind, ModelSpec, TrainConfig, TrainedModel, N_FINGERS,
+};
 use decoder::session::{check_gates, GateConfig, Session, WindowOptions};
 use hand_clock::{Clock, SystemClock, VirtualClock};
 use hand_dbc::candump::LogWriter;
@@ -45,6 +47,11 @@ pub struct DemoOptions {
     pub work_dir: PathBuf,
     /// Training epochs at most.
     pub max_epochs: usize,
+    /// The paper's plain training, without the effort-ray penalty.
+    pub plain: bool,
+    /// The paper's labels: the fingers a single-finger trial does not move are masked out of
+    /// the loss instead of trained toward 0.
+    pub mask_others: bool,
 }
 
 impl Default for DemoOptions {
@@ -56,6 +63,8 @@ impl Default for DemoOptions {
             settle_s: 4.0,
             work_dir: std::env::temp_dir().join("handstack-demo"),
             max_epochs: 200,
+            plain: false,
+            mask_others: false,
         }
     }
 }
@@ -81,6 +90,10 @@ pub struct DemoReport {
     pub mape: Option<f64>,
     /// Coefficient of determination.
     pub r2: f64,
+    /// Selectivity: per finger (0 thumb .. 4 pinky), the mean |label| the decoder gave it over
+    /// the scored samples, while only the index finger moves (the other fingers should stay
+    /// near 0).
+    pub mean_abs_label: [f64; N_FINGERS],
     /// The daemon's snapshot at the end (latency, deadline misses, ...).
     pub end: Snapshot,
 }
@@ -171,6 +184,37 @@ pub fn record_calibration(dir: &Path, seed: u64) -> Result<usize, DemoError> {
     Ok(run.trials.len())
 }
 
+/// Trains ResDD on the calibration session with the demo's label and training options.
+fn train_resdd(
+    session: &Session,
+    opts: &DemoOptions,
+    on: &mut impl FnMut(DemoEvent<'_>),
+) -> Result<TrainedModel, DemoError> {
+    let data = session
+        .windows(&WindowOptions {
+            mask_others: opts.mask_others,
+            ..WindowOptions::default()
+        })?
+        .to_dataset(&session.meta.chain)?;
+    let base = if opts.plain {
+        TrainConfig::plain()
+    } else {
+        TrainConfig::default()
+    };
+    let cfg = TrainConfig {
+        max_epochs: opts.max_epochs,
+        seed: opts.seed,
+        ..base
+    };
+    Ok(train(
+        ModelKind::ResDd,
+        &ModelSpec::default(),
+        &data,
+        &cfg,
+        &mut |r| on(DemoEvent::Epoch(r)),
+    )?)
+}
+
 /// Calibrate, train, track; see the module docs.
 pub fn run_demo(
     opts: &DemoOptions,
@@ -190,21 +234,7 @@ pub fn run_demo(
     on(DemoEvent::Phase(
         "training ResDD on the calibration session",
     ));
-    let data = session
-        .windows(&WindowOptions { two_point: false })?
-        .to_dataset(&session.meta.chain)?;
-    let cfg = TrainConfig {
-        max_epochs: opts.max_epochs,
-        seed: opts.seed,
-        ..TrainConfig::default()
-    };
-    let model = train(
-        ModelKind::ResDd,
-        &ModelSpec::default(),
-        &data,
-        &cfg,
-        &mut |r| on(DemoEvent::Epoch(r)),
-    )?;
+    let model = train_resdd(&session, opts, &mut on)?;
     let model_path = opts.work_dir.join("model.hsm");
     model.save(&model_path)?;
 
@@ -218,8 +248,11 @@ pub fn run_demo(
     };
     let skip = (opts.settle_s * 50.0) as usize;
     let scored = samples.get(skip..).unwrap_or(&[]);
-    let target: Vec<f64> = scored.iter().map(|s| s.0).collect();
-    let tracked: Vec<f64> = scored.iter().map(|s| s.1).collect();
+    let target: Vec<f64> = scored.iter().map(|s| s.target).collect();
+    let tracked: Vec<f64> = scored.iter().map(|s| s.tracked).collect();
+    let n = scored.len().max(1) as f64;
+    let mean_abs_label: [f64; N_FINGERS] =
+        std::array::from_fn(|f| scored.iter().map(|s| s.labels[f].abs()).sum::<f64>() / n);
     let m = tracking_metrics(&target, &tracked)?;
     let s = model.summary();
     Ok(DemoReport {
@@ -232,6 +265,7 @@ pub fn run_demo(
         rmse: m.rmse,
         mape: m.mape,
         r2: m.r2,
+        mean_abs_label,
         end,
     })
 }
@@ -247,14 +281,24 @@ impl DemoClock for VirtualClock {
 }
 impl DemoClock for SystemClock {}
 
-/// Runs the closed loop; returns (target, tracked) at every index FINGER_STATUS.
+/// One scored moment: at an index FINGER_STATUS.
+struct TrackSample {
+    /// The sine's target.
+    target: f64,
+    /// The index finger's force / full scale.
+    tracked: f64,
+    /// The decoder's raw label of every finger (before conditioning), from the snapshot.
+    labels: [f64; N_FINGERS],
+}
+
+/// Runs the closed loop; returns a sample at every index FINGER_STATUS.
 fn track<K: DemoClock>(
     model: &TrainedModel,
     opts: &DemoOptions,
     clock: K,
     virtual_time: bool,
     on: &mut impl FnMut(DemoEvent<'_>),
-) -> Result<(Vec<(f64, f64)>, Snapshot), DemoError> {
+) -> Result<(Vec<TrackSample>, Snapshot), DemoError> {
     let tracking = TrackingConfig {
         seed: opts.seed,
         ..TrackingConfig::default()
@@ -318,7 +362,12 @@ fn track<K: DemoClock>(
                 if let Ok(st) = FingerStatus::decode(id, r.frame.data()) {
                     let t = r.time_us.unwrap_or(now).saturating_sub(start);
                     tracked = st.force() / tracking.full_scale_force_n;
-                    samples.push((tracking.target.at(t), tracked));
+                    let snap = *runner.snapshot().lock().unwrap_or_else(|e| e.into_inner());
+                    samples.push(TrackSample {
+                        target: tracking.target.at(t),
+                        tracked,
+                        labels: snap.labels,
+                    });
                 }
             }
         }

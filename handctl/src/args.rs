@@ -104,6 +104,12 @@ pub struct DemoArgs {
     /// Where the calibration session and the model are written (default: a temp directory).
     #[arg(long)]
     pub dir: Option<PathBuf>,
+    /// The paper's plain training, without the effort-ray penalty.
+    #[arg(long)]
+    pub plain: bool,
+    /// The paper's labels: fingers a single-finger trial does not move are left out of the loss.
+    #[arg(long)]
+    pub paper_masks: bool,
 }
 
 fn parse_seconds(s: &str) -> Result<f64, String> {
@@ -121,6 +127,14 @@ pub struct TrainingOpts {
     /// The paper's two-point calibration: flexion and extension only, rest trials unused.
     #[arg(long)]
     pub two_point: bool,
+    /// The paper's plain training: masked MSE alone, without the effort-ray penalty that keeps
+    /// the decoder monotonic in effort.
+    #[arg(long)]
+    pub plain: bool,
+    /// The paper's labels: during a single-finger trial the other fingers are left out of the
+    /// loss instead of being trained toward 0.
+    #[arg(long)]
+    pub paper_masks: bool,
     /// Seed for initialisation, validation split and shuffling.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,

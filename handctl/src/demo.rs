@@ -22,6 +22,8 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
             .dir
             .clone()
             .unwrap_or_else(|| std::env::temp_dir().join("handstack-demo")),
+        plain: a.plain,
+        mask_others: a.paper_masks,
         ..DemoOptions::default()
     };
     let tty = std::io::stdout().is_terminal();
@@ -86,6 +88,7 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
         report.mape.map_or("n/a".into(), |m| format!("{m:.1}%")),
         report.r2
     );
+    println!("{}", selectivity(&report.mean_abs_label));
     println!(
         "daemon: latency p50 {} us p99 {} us, compute p50 {} us p99 {} us, deadline misses {}, state {}",
         report.end.latency.p50_us,
@@ -96,4 +99,15 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
         report.end.state
     );
     Ok(())
+}
+
+/// The selectivity line: the mean |label| of every finger while the index tracks.
+fn selectivity(mean_abs_label: &[f64; 5]) -> String {
+    let fingers: Vec<String> = (0..5)
+        .map(|f| format!("{} {:.3}", FINGER_NAMES[f], mean_abs_label[f]))
+        .collect();
+    format!(
+        "selectivity (mean |label| per finger while the index tracks; others should stay near 0): {}",
+        fingers.join(", ")
+    )
 }

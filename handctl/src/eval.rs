@@ -12,7 +12,7 @@ use decoder::session::{LabelledWindows, Session, WindowOptions};
 
 use super::args::EvalArgs;
 use super::error::CliError;
-use super::train::{describe, fit, gate};
+use super::train::{describe, fit, gate, window_options};
 
 /// Train and test windows: a separate test session, or the held-out last repetitions.
 fn split(
@@ -30,7 +30,7 @@ fn split(
                 )));
             }
             // Testing always includes rest (to measure rest drift) even for a two-point model.
-            let test_windows = test.windows(&WindowOptions { two_point: false })?;
+            let test_windows = test.windows(&WindowOptions::default())?;
             Ok((
                 all,
                 test_windows,
@@ -47,7 +47,7 @@ fn split(
             }
             let train = all.filter_trials(|t| !held[t]);
             let test = session
-                .windows(&WindowOptions { two_point: false })?
+                .windows(&WindowOptions::default())?
                 .filter_trials(|t| held[t]);
             Ok((
                 train,
@@ -65,9 +65,7 @@ fn split(
 pub fn run(a: &EvalArgs) -> Result<(), CliError> {
     let session = Session::open_spec(&a.session)?;
     gate(&session, &a.training)?;
-    let opts = WindowOptions {
-        two_point: a.training.two_point,
-    };
+    let opts = window_options(&a.training);
     let (train_w, test_w, what) = split(a, &session, &opts)?;
     let data = train_w.to_dataset(&session.meta.chain)?;
     if let Some(dir) = &a.plots {

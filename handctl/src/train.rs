@@ -26,17 +26,30 @@ pub(super) fn gate(session: &Session, opts: &TrainingOpts) -> Result<(), CliErro
     }
 }
 
+/// How the training windows are labelled, from the CLI's flags.
+pub(super) fn window_options(opts: &TrainingOpts) -> WindowOptions {
+    WindowOptions {
+        two_point: opts.two_point,
+        mask_others: opts.paper_masks,
+    }
+}
+
 /// Trains one model with the CLI's settings, showing progress on a terminal.
 pub(super) fn fit(
     kind: ModelKind,
     data: &Dataset,
     opts: &TrainingOpts,
 ) -> Result<TrainedModel, CliError> {
+    let base = if opts.plain {
+        TrainConfig::plain()
+    } else {
+        TrainConfig::default()
+    };
     let cfg = TrainConfig {
         max_epochs: opts.epochs,
         seed: opts.seed,
         split: opts.validation,
-        ..TrainConfig::default()
+        ..base
     };
     let mut progress = Progress::new(kind.name());
     let model = train(kind, &ModelSpec::default(), data, &cfg, &mut |r| {
@@ -75,9 +88,7 @@ pub(super) fn describe(model: &TrainedModel) -> String {
 pub fn run(a: &TrainArgs) -> Result<(), CliError> {
     let session = Session::open_spec(&a.session)?;
     gate(&session, &a.training)?;
-    let windows = session.windows(&WindowOptions {
-        two_point: a.training.two_point,
-    })?;
+    let windows = session.windows(&window_options(&a.training))?;
     let data = windows.to_dataset(&session.meta.chain)?;
     let model = fit(a.model, &data, &a.training)?;
     model.save(&a.output)?;

@@ -4,6 +4,7 @@ use std::str::FromStr;
 
 use serde::{Deserialize, Serialize};
 
+use super::effort::EffortPenalty;
 use super::error::TrainError;
 
 /// Gradient step rule.
@@ -179,6 +180,11 @@ pub struct TrainConfig {
     pub split: ValidationSplit,
     /// Seed for initialisation, split and shuffling (default 0).
     pub seed: u64,
+    /// The effort-ray penalty that keeps the decoder monotonic in effort (default on; `None`
+    /// is the paper's plain training, and what a model file without the field was trained
+    /// with).
+    #[serde(default)]
+    pub effort: Option<EffortPenalty>,
 }
 
 impl Default for TrainConfig {
@@ -191,14 +197,26 @@ impl Default for TrainConfig {
             min_delta: 1e-6,
             split: ValidationSplit::default(),
             seed: 0,
+            effort: Some(EffortPenalty::default()),
         }
     }
 }
 
 impl TrainConfig {
+    /// The paper's plain training: the defaults without the effort-ray penalty.
+    pub fn plain() -> Self {
+        TrainConfig {
+            effort: None,
+            ..TrainConfig::default()
+        }
+    }
+
     /// Checks every field; the error names the field and its allowed range.
     pub fn validate(&self) -> Result<(), TrainError> {
         self.optimizer.validate()?;
+        if let Some(effort) = &self.effort {
+            effort.validate()?;
+        }
         let bad = |m: String| Err(TrainError::Config(m));
         if self.batch_size == 0 || self.batch_size > 1 << 20 {
             return bad(format!(
@@ -232,6 +250,55 @@ impl TrainConfig {
                 ))
             }
             _ => Ok(()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_config_without_the_effort_field_is_the_plain_training() {
+        let mut json = serde_json::to_value(TrainConfig::default()).expect("serialise");
+        assert!(json["effort"].is_object(), "{json}");
+        json.as_object_mut().expect("object").remove("effort");
+        let old: TrainConfig = serde_json::from_value(json).expect("old files still load");
+        assert_eq!(old, TrainConfig::plain());
+        assert_ne!(old, TrainConfig::default());
+    }
+
+    #[test]
+    fn bad_effort_settings_are_refused_by_name() {
+        for (bad, field) in [
+            (
+                EffortPenalty {
+                    weight: 0.0,
+                    ..EffortPenalty::default()
+                },
+                "weight",
+            ),
+            (
+                EffortPenalty {
+                    points: 0,
+                    ..EffortPenalty::default()
+                },
+                "points",
+            ),
+            (
+                EffortPenalty {
+                    min_slope: 1.5,
+                    ..EffortPenalty::default()
+                },
+                "min_slope",
+            ),
+        ] {
+            let cfg = TrainConfig {
+                effort: Some(bad),
+                ..TrainConfig::default()
+            };
+            let err = cfg.validate().expect_err("refused").to_string();
+            assert!(err.contains(field), "{err}");
         }
     }
 }

@@ -4,8 +4,8 @@
 //!   run time) share the [`Model`] trait (allocation-free inference with a caller-owned
 //!   [`Scratch`]) and the [`Trainable`] trait (flat parameters and an analytic gradient).
 //! - [`Normalizer`]: per-feature scale, no centring, so zero input stays zero.
-//! - [`Dataset`] + [`train`]: masked MSE, Adam or SGD, early stopping on held-out trials,
-//!   deterministic for a given seed.
+//! - [`Dataset`] + [`train`]: masked MSE plus the effort-ray penalty ([`EffortPenalty`]), Adam
+//!   or SGD, early stopping on held-out trials, deterministic for a given seed.
 //! - [`TrainedModel`]: what a model file holds ([`TrainedModel::save`] / [`TrainedModel::load`]);
 //!   [`Predictor`] runs it in the daemon's tick.
 //!
@@ -18,6 +18,7 @@ mod cnn;
 mod config;
 mod dataset;
 mod dense;
+mod effort;
 mod error;
 mod file;
 mod init;
@@ -39,6 +40,7 @@ pub use cnn::Cnn;
 pub use config::{Optimizer, TrainConfig, ValidationSplit};
 pub use dataset::{Dataset, N_FINGERS};
 pub use dense::DenseNet;
+pub use effort::{ray_directions, ray_penalty, EffortPenalty, RayWork, MAX_EFFORT_POINTS};
 pub use error::{FileError, ModelError, TrainError};
 pub use file::{FORMAT_VERSION, HEADER_LEN, MAGIC, NORMALIZER_TENSOR};
 pub use kind::ModelKind;

@@ -1,14 +1,18 @@
-//! The training loop: masked MSE, mini-batches, Adam or SGD, early stopping on held-out data.
+//! The training loop: masked MSE plus the effort-ray penalty (see [`super::effort`]),
+//! mini-batches, Adam or SGD, early stopping on held-out data.
 //!
 //! Deterministic: one ChaCha8 stream seeded from [`TrainConfig::seed`] makes the split, the
-//! initial weights and the per-epoch shuffles, in that order; every sum runs in a fixed order on
-//! one thread. The same seed and the same data therefore give bit-identical weights.
+//! initial weights, and per epoch the shuffle and then the penalty's jittered efforts, in that
+//! order; every sum runs in a fixed order on one thread. The same seed and the same data
+//! therefore give bit-identical weights. Without the penalty no effort is drawn, so the plain
+//! training's stream, and its weights, are those from before the penalty existed.
 
 use std::time::Instant;
 
 use super::any::AnyModel;
-use super::config::{Optimizer, TrainConfig};
+use super::config::TrainConfig;
 use super::dataset::{Dataset, N_FINGERS};
+use super::effort::{ray_directions, ray_penalty, EffortPenalty, RayWork};
 use super::error::TrainError;
 use super::init::SeededRng;
 use super::kind::ModelKind;
@@ -28,9 +32,13 @@ pub struct EpochReport {
     /// The configured upper bound on epochs.
     pub max_epochs: usize,
     /// Mean masked squared error over the training windows during this epoch (running mean
-    /// over its mini-batches, as the weights moved).
+    /// over its mini-batches, as the weights moved); the effort penalty is not included.
     pub train_loss: f64,
-    /// Masked MSE on the held-out windows after this epoch (None without a split).
+    /// The effort-ray penalty per unmasked target during this epoch, unweighted (None
+    /// without the penalty).
+    pub effort_penalty: Option<f64>,
+    /// Masked MSE on the held-out windows after this epoch, plus the weighted effort penalty
+    /// there when it is on (None without a split).
     pub val_loss: Option<f64>,
     /// Epoch with the best validation loss so far (the current one without a split).
     pub best_epoch: usize,
@@ -67,17 +75,33 @@ struct Workspace {
     scratch: Scratch,
     y: [f64; N_FINGERS],
     dy: [f64; N_FINGERS],
+    /// The penalty's settings and buffers, when it is on.
+    effort: Option<EffortWork>,
+}
+
+/// The effort penalty's settings and per-ray buffers.
+struct EffortWork {
+    cfg: EffortPenalty,
+    jitter: Vec<f64>,
+    ks: Vec<f64>,
+    ray: RayWork,
 }
 
 impl Workspace {
-    fn new(model: &AnyModel, optimizer: Optimizer) -> Self {
+    fn new(model: &AnyModel, cfg: &TrainConfig) -> Self {
         let n_params = model.params().len();
         Workspace {
-            opt: OptimState::new(optimizer, n_params),
+            opt: OptimState::new(cfg.optimizer, n_params),
             grad: vec![0.0; n_params],
             scratch: model.new_scratch(),
             y: [0.0; N_FINGERS],
             dy: [0.0; N_FINGERS],
+            effort: cfg.effort.map(|e| EffortWork {
+                cfg: e,
+                jitter: vec![0.0; e.points],
+                ks: vec![0.0; e.points + 2],
+                ray: RayWork::new(model.n_inputs(), e.points + 2),
+            }),
         }
     }
 }
@@ -146,6 +170,43 @@ fn masked_mse(model: &AnyModel, set: &Normalized<'_>, idx: &[usize], scratch: &m
     }
 }
 
+/// The objective on the held-out windows `idx`: masked MSE, plus with the effort penalty its
+/// weighted value per unmasked target at the strata's midpoints (fixed efforts, so epochs are
+/// compared on the same points).
+fn validation_loss(
+    model: &AnyModel,
+    set: &Normalized<'_>,
+    idx: &[usize],
+    ws: &mut Workspace,
+) -> f64 {
+    let mse = masked_mse(model, set, idx, &mut ws.scratch);
+    let Some(e) = ws.effort.as_mut() else {
+        return mse;
+    };
+    e.jitter.fill(0.5);
+    e.cfg.efforts(&e.jitter, &mut e.ks);
+    let (mut penalty, mut count) = (0.0, 0usize);
+    for &i in idx {
+        let (t, m) = (set.data.target(i), set.data.mask(i));
+        count += m.iter().filter(|&&b| b).count();
+        let dirs = ray_directions(t, m);
+        if dirs.iter().any(|&d| d != 0.0) {
+            let (x, ks) = (set.x(i), &e.ks);
+            penalty += ray_penalty(
+                model,
+                x,
+                &dirs,
+                ks,
+                e.cfg.min_slope,
+                &mut e.ray,
+                &mut ws.scratch,
+                None,
+            );
+        }
+    }
+    mse + e.cfg.weight * penalty / count.max(1) as f64
+}
+
 fn distinct_trials(data: &Dataset, idx: &[usize]) -> usize {
     let mut t: Vec<usize> = idx.iter().map(|&i| data.trial(i)).collect();
     t.sort_unstable();
@@ -165,17 +226,28 @@ fn check_inputs(data: &Dataset, cfg: &TrainConfig) -> Result<(), TrainError> {
     Ok(())
 }
 
-/// Puts the gradient of the batch's masked MSE into `ws.grad` (`inv` is one over the batch's
-/// unmasked target count) and adds the batch's squared errors to `loss_sum`.
+/// Running sums of one epoch.
+#[derive(Default)]
+struct EpochSums {
+    loss: f64,
+    penalty: f64,
+    count: usize,
+}
+
+/// Puts the gradient of the batch's masked MSE, plus the weighted effort penalty, into
+/// `ws.grad` (`inv` is one over the batch's unmasked target count, which both are divided by)
+/// and adds the batch's squared errors and penalty to `sums`.
 fn batch_gradient(
     model: &AnyModel,
     set: &Normalized<'_>,
     batch: &[usize],
     inv: f64,
     ws: &mut Workspace,
-    loss_sum: &mut f64,
+    sums: &mut EpochSums,
+    rng: &mut SeededRng,
 ) {
     ws.grad.fill(0.0);
+    let loss_sum = &mut sums.loss;
     for &i in batch {
         let x = set.x(i);
         model.predict_with(x, &mut ws.y, &mut ws.scratch);
@@ -191,18 +263,42 @@ fn batch_gradient(
         }
         model.backward(x, &ws.dy, &mut ws.scratch, &mut ws.grad);
     }
+    if let Some(e) = ws.effort.as_mut() {
+        for &i in batch {
+            let dirs = ray_directions(set.data.target(i), set.data.mask(i));
+            if dirs.iter().all(|&d| d == 0.0) {
+                continue;
+            }
+            for u in e.jitter.iter_mut() {
+                *u = rng.unit();
+            }
+            e.cfg.efforts(&e.jitter, &mut e.ks);
+            let grad = Some((&mut ws.grad[..], e.cfg.weight * inv));
+            sums.penalty += ray_penalty(
+                model,
+                set.x(i),
+                &dirs,
+                &e.ks,
+                e.cfg.min_slope,
+                &mut e.ray,
+                &mut ws.scratch,
+                grad,
+            );
+        }
+    }
 }
 
 /// One pass over the training windows in `order`, one optimizer step per mini-batch. Returns
-/// the mean masked squared error seen during the pass.
+/// the mean masked squared error seen during the pass and the mean effort penalty.
 fn run_epoch(
     model: &mut AnyModel,
     set: &Normalized<'_>,
     order: &[usize],
     batch_size: usize,
     ws: &mut Workspace,
-) -> f64 {
-    let (mut loss_sum, mut loss_count) = (0.0, 0usize);
+    rng: &mut SeededRng,
+) -> (f64, f64) {
+    let mut sums = EpochSums::default();
     for batch in order.chunks(batch_size) {
         let count: usize = batch
             .iter()
@@ -211,11 +307,12 @@ fn run_epoch(
         if count == 0 {
             continue;
         }
-        batch_gradient(model, set, batch, 1.0 / count as f64, ws, &mut loss_sum);
-        loss_count += count;
+        batch_gradient(model, set, batch, 1.0 / count as f64, ws, &mut sums, rng);
+        sums.count += count;
         ws.opt.step(model.params_mut(), &ws.grad);
     }
-    loss_sum / loss_count.max(1) as f64
+    let n = sums.count.max(1) as f64;
+    (sums.loss / n, sums.penalty / n)
 }
 
 /// Runs epochs until `max_epochs` or early stopping, calling `progress` after each, and leaves
@@ -228,21 +325,21 @@ fn run_epochs(
     rng: &mut SeededRng,
     progress: &mut dyn FnMut(EpochReport),
 ) -> Result<Outcome, TrainError> {
-    let mut ws = Workspace::new(model, cfg.optimizer);
+    let mut ws = Workspace::new(model, cfg);
     let mut order = split.train.clone();
     let has_val = !split.val.is_empty();
     let mut best = Best::new(model.params());
     let (mut epochs_run, mut final_train_loss, mut stopped_early) = (0, f64::NAN, false);
     for epoch in 1..=cfg.max_epochs {
         rng.shuffle(&mut order);
-        let train_loss = run_epoch(model, set, &order, cfg.batch_size, &mut ws);
+        let (train_loss, penalty) = run_epoch(model, set, &order, cfg.batch_size, &mut ws, rng);
         epochs_run = epoch;
         final_train_loss = train_loss;
         if !train_loss.is_finite() || model.params().iter().any(|p| !p.is_finite()) {
             return Err(TrainError::Diverged { epoch });
         }
         let val_loss = if has_val {
-            let v = masked_mse(model, set, &split.val, &mut ws.scratch);
+            let v = validation_loss(model, set, &split.val, &mut ws);
             if !v.is_finite() {
                 return Err(TrainError::Diverged { epoch });
             }
@@ -256,6 +353,7 @@ fn run_epochs(
             epoch,
             max_epochs: cfg.max_epochs,
             train_loss,
+            effort_penalty: cfg.effort.map(|_| penalty),
             val_loss,
             best_epoch: best.epoch,
         });

@@ -164,7 +164,7 @@ fn noisy_at_rest(
 
 /// Runs every gate over a session.
 pub fn check_gates(session: &Session, config: &GateConfig) -> Result<GateReport, SessionError> {
-    let windows = session.windows(&WindowOptions { two_point: false })?;
+    let windows = session.windows(&WindowOptions::default())?;
     let trials = &session.meta.trials;
     let mut report = GateReport::default();
     let (rms, count) = trial_rms(&windows, session.recording.channels, trials.len());

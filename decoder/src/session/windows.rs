@@ -11,6 +11,22 @@ pub struct WindowOptions {
     /// The paper's two-point calibration: flexion (+1) and extension (-1) only, rest trials
     /// left out. Without a rest anchor, rest drifts away from zero; kept to reproduce the paper.
     pub two_point: bool,
+    /// The paper's labels: during a single-finger trial the other fingers are masked out of the
+    /// loss. By default (false) they are trained toward 0, the patient's intent, so a finger
+    /// the trial does not move learns to stay still instead of following the one that moves.
+    pub mask_others: bool,
+}
+
+impl WindowOptions {
+    /// The loss mask of a trial's windows: all five fingers, or with
+    /// [`WindowOptions::mask_others`] the fingers the trial moves.
+    pub fn mask(&self, trial: &super::Trial) -> [bool; N_FINGERS] {
+        if self.mask_others {
+            trial.involved()
+        } else {
+            [true; N_FINGERS]
+        }
+    }
 }
 
 /// The label of one window.
@@ -20,7 +36,8 @@ pub struct WindowLabel {
     pub trial: usize,
     /// Per-finger targets: +1 flexion, -1 extension, 0 rest.
     pub targets: [f64; N_FINGERS],
-    /// Fingers whose target counts (the trial's finger; all five for rest and "all" trials).
+    /// Fingers whose target counts: all five, or with [`WindowOptions::mask_others`] the trial's
+    /// finger alone (all five for rest and "all" trials).
     pub mask: [bool; N_FINGERS],
     /// Exclusive end of the window, as a sample index of the recording.
     pub end_sample: usize,
@@ -119,7 +136,7 @@ impl Session {
                 out.labels.push(WindowLabel {
                     trial: *ti,
                     targets: t.targets(),
-                    mask: t.involved(),
+                    mask: opts.mask(t),
                     end_sample: end,
                 });
             }

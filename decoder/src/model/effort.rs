@@ -1,0 +1,192 @@
+//! The effort-ray penalty (issue 12): training that keeps a decoder monotonic in effort.
+//!
+//! A calibration window scaled to effort `k` has its amplitude features scaled by `k` and VAR
+//! by `k²` (the same ray [`crate::eval::scale_features`] and the exact verifier use; the
+//! normalizer is scale-only, so a ray of normalized features is a ray of raw ones). Along the
+//! ray of a flexion (`s = +1`) or extension (`s = -1`) window, the trial's finger must move in
+//! the trial's direction. The penalty samples the ray at `k = 0`, one jittered point in each of
+//! [`EffortPenalty::points`] equal strata of `(0, 1)`, and `k = 1`, and charges every interval
+//! whose slope in the trial's direction falls short of [`EffortPenalty::min_slope`]:
+//!
+//! `P = Σ_j Δk_j · max(0, m − s·Δy_j / Δk_j)²`
+//!
+//! a Riemann sum of `∫ max(0, m − s·y'(k))² dk`. It is zero for a curve that rises with at
+//! least slope `m` everywhere and grows with the size of every reversal, so its gradient pushes
+//! reversals out. The jitter is redrawn every epoch, so over the epochs the whole ray is
+//! covered, not a fixed grid that a reversal could hide between; the exact verifier
+//! ([`super::verify`]) judges the result afterwards.
+
+use serde::{Deserialize, Serialize};
+
+use super::dataset::N_FINGERS;
+use super::error::TrainError;
+use super::traits::{Scratch, Trainable};
+use crate::eval::scale_features;
+
+/// Settings of the effort-ray penalty.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct EffortPenalty {
+    /// Weight of the penalty against the mean squared error (default 30, tuned with Adam,
+    /// whose step does not grow with the gradient; with SGD the weight multiplies the step, so
+    /// use a weight near 1 there).
+    pub weight: f64,
+    /// Jittered efforts per ray between 0 and 1, besides both ends (default 6).
+    pub points: usize,
+    /// Slope in the trial's direction below which an interval is charged, label units per unit
+    /// of effort; the ideal `y = s·k` has slope 1 (default 0.3).
+    pub min_slope: f64,
+}
+
+impl Default for EffortPenalty {
+    fn default() -> Self {
+        EffortPenalty {
+            weight: 30.0,
+            points: 6,
+            min_slope: 0.3,
+        }
+    }
+}
+
+/// Most jittered points per ray.
+pub const MAX_EFFORT_POINTS: usize = 64;
+
+impl EffortPenalty {
+    /// Checks every field; the error names the field and its allowed range.
+    pub fn validate(&self) -> Result<(), TrainError> {
+        let bad = |m: String| Err(TrainError::Config(m));
+        if !(self.weight > 0.0 && self.weight.is_finite()) {
+            return bad(format!(
+                "effort penalty weight must be > 0 and finite, got {}",
+                self.weight
+            ));
+        }
+        if !(1..=MAX_EFFORT_POINTS).contains(&self.points) {
+            return bad(format!(
+                "effort penalty points must be in 1..={MAX_EFFORT_POINTS}, got {}",
+                self.points
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.min_slope) {
+            return bad(format!(
+                "effort penalty min_slope must be in [0, 1], got {}",
+                self.min_slope
+            ));
+        }
+        Ok(())
+    }
+
+    /// Fills `ks` with `0`, one point per stratum `((j + u_j) / points)` for the `u_j` in
+    /// `jitter` (each in `[0, 1)`), and `1`. `ks` must be `points + 2` long.
+    pub fn efforts(&self, jitter: &[f64], ks: &mut [f64]) {
+        assert_eq!(jitter.len(), self.points, "one jitter per stratum");
+        assert_eq!(ks.len(), self.points + 2, "efforts: points + 2");
+        let n = self.points as f64;
+        ks[0] = 0.0;
+        for (j, (k, u)) in ks[1..=self.points].iter_mut().zip(jitter).enumerate() {
+            *k = (j as f64 + u) / n;
+        }
+        ks[self.points + 1] = 1.0;
+    }
+}
+
+/// Buffers for one ray: the scaled input, the outputs at every effort and their gradients.
+#[derive(Debug, Clone)]
+pub struct RayWork {
+    x: Vec<f64>,
+    y: Vec<[f64; N_FINGERS]>,
+    dy: Vec<[f64; N_FINGERS]>,
+}
+
+impl RayWork {
+    /// Buffers for `n_inputs` features and `n_efforts` points per ray.
+    pub fn new(n_inputs: usize, n_efforts: usize) -> Self {
+        RayWork {
+            x: vec![0.0; n_inputs],
+            y: vec![[0.0; N_FINGERS]; n_efforts],
+            dy: vec![[0.0; N_FINGERS]; n_efforts],
+        }
+    }
+}
+
+/// The penalty of one window's ray, `Σ_f P_f` over the fingers with `dirs[f] != 0` (`±1`, the
+/// trial's direction for that finger), at the efforts `ks` (ascending, from
+/// [`EffortPenalty::efforts`]), with slope margin `min_slope`. When `grad` is given, adds
+/// `scale · ∂P/∂θ` to it. `x` is the window's normalized features; `scratch` must fit `model`.
+#[allow(clippy::too_many_arguments)]
+pub fn ray_penalty<M: Trainable + ?Sized>(
+    model: &M,
+    x: &[f64],
+    dirs: &[f64; N_FINGERS],
+    ks: &[f64],
+    min_slope: f64,
+    work: &mut RayWork,
+    scratch: &mut Scratch,
+    grad: Option<(&mut [f64], f64)>,
+) -> f64 {
+    assert!(
+        ks.len() >= 2 && work.y.len() >= ks.len(),
+        "ray work too small"
+    );
+    for (j, &k) in ks.iter().enumerate() {
+        scale_features(x, k, &mut work.x);
+        model.predict_with(&work.x, &mut work.y[j][..model.n_outputs()], scratch);
+        work.dy[j] = [0.0; N_FINGERS];
+    }
+    let mut penalty = 0.0;
+    for j in 0..ks.len() - 1 {
+        let dk = ks[j + 1] - ks[j];
+        if dk <= 0.0 {
+            continue;
+        }
+        for (f, &s) in dirs.iter().enumerate().filter(|(_, &s)| s != 0.0) {
+            let r = min_slope - s * (work.y[j + 1][f] - work.y[j][f]) / dk;
+            if r > 0.0 {
+                penalty += dk * r * r;
+                // ∂(dk·r²)/∂y_{j+1} = -2·s·r, ∂/∂y_j = +2·s·r.
+                work.dy[j + 1][f] -= 2.0 * s * r;
+                work.dy[j][f] += 2.0 * s * r;
+            }
+        }
+    }
+    if let Some((grad, scale)) = grad {
+        backward_points(model, x, ks, work, scratch, grad, scale);
+    }
+    penalty
+}
+
+/// Back-propagates the output gradients of the points that have one.
+fn backward_points<M: Trainable + ?Sized>(
+    model: &M,
+    x: &[f64],
+    ks: &[f64],
+    work: &mut RayWork,
+    scratch: &mut Scratch,
+    grad: &mut [f64],
+    scale: f64,
+) {
+    let n_out = model.n_outputs();
+    for (j, &k) in ks.iter().enumerate() {
+        if work.dy[j].iter().all(|&d| d == 0.0) {
+            continue;
+        }
+        for d in work.dy[j].iter_mut() {
+            *d *= scale;
+        }
+        scale_features(x, k, &mut work.x);
+        let mut y = [0.0; N_FINGERS];
+        model.predict_with(&work.x, &mut y[..n_out], scratch);
+        model.backward(&work.x, &work.dy[j][..n_out], scratch, grad);
+    }
+}
+
+/// The direction of every finger whose ray a window's label constrains: `±1` where the finger
+/// counts and its target is non-zero, 0 elsewhere (rest, and fingers trained toward 0).
+pub fn ray_directions(target: &[f64; N_FINGERS], mask: &[bool; N_FINGERS]) -> [f64; N_FINGERS] {
+    std::array::from_fn(|f| {
+        if mask[f] && target[f] != 0.0 {
+            target[f].signum()
+        } else {
+            0.0
+        }
+    })
+}
