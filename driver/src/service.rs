@@ -8,7 +8,7 @@ use crate::config::Config;
 use crate::control::Peer;
 use crate::daemon::SharedSnapshot;
 use crate::engine::Command;
-use crate::protocol::{FingerStatus, Reply, Request, Status};
+use crate::protocol::{FingerStatus, ModelStatus, Reply, Request, Status};
 use crate::tuning::{commit_tune, plan_tune, user_name};
 use crate::units::{FINGER_NAMES, N_FINGERS};
 
@@ -18,6 +18,7 @@ pub struct ControlHandler {
     config_path: PathBuf,
     snapshot: SharedSnapshot,
     commands: Sender<Command>,
+    model: Option<ModelStatus>,
 }
 
 impl ControlHandler {
@@ -34,7 +35,14 @@ impl ControlHandler {
             config_path,
             snapshot,
             commands,
+            model: None,
         }
+    }
+
+    /// The handler, telling `status` which model runs.
+    pub fn with_model(mut self, model: ModelStatus) -> Self {
+        self.model = Some(model);
+        self
     }
 
     /// The status as `handctl status` shows it.
@@ -61,6 +69,7 @@ impl ControlHandler {
                     kalpha: s.gains[f].kalpha,
                 })
                 .collect(),
+            model: self.model.clone(),
         }
     }
 

@@ -312,3 +312,121 @@ fn the_demo_says_how_to_build_it_and_socket_failures_are_not_usage_errors() {
         "{e}"
     );
 }
+
+/// A session no model can fit without going back against the effort: the index finger's
+/// extension is its flexion's very pattern at half the amplitude, so along a flexion ray the
+/// label must pass -1 (at half effort) on its way from 0 to +1. Two channels, rest included.
+fn contradictory_session(dir: &Path) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let plan: [(&str, [f64; 2]); 3] = [
+        ("rest", [5.0, 5.0]),
+        ("flexion", [100.0, 40.0]),
+        ("extension", [50.0, 20.0]),
+    ];
+    let mut samples = Vec::new();
+    let mut labels = String::from("finger,kind,repetition,start_sample,end_sample\n");
+    let mut rng = 11u64;
+    for rep in 1..=2 {
+        for (kind, amps) in plan {
+            let start = samples.len() / 2;
+            for _ in 0..2000 {
+                for a in amps {
+                    samples.push((a * noise(&mut rng)).round());
+                }
+            }
+            let finger = if kind == "rest" { "all" } else { "index" };
+            labels.push_str(&format!("{finger},{kind},{rep},{start},{}\n", start + 2000));
+        }
+    }
+    let npy = dir.join("emg.npy");
+    decoder::session::write_npy_f64(&npy, samples.len() / 2, 2, &samples).unwrap();
+    std::fs::write(dir.join("labels.csv"), labels).unwrap();
+    let session = dir.join("session");
+    let out = handctl(&[
+        "import",
+        "--samples",
+        s(&npy),
+        "--labels",
+        s(&dir.join("labels.csv")),
+        "--channels",
+        "2",
+        "--rows-are-recordings",
+        "-o",
+        s(&session),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    session
+}
+
+/// The lines of `handctl eval`'s output from Table 3 to the end of Table 4.
+fn tables(stdout: &str) -> String {
+    let from = stdout.find("Table 3").expect("Table 3 printed");
+    let rest = &stdout[from..];
+    let end = rest.find("\nEffort rays").unwrap_or(rest.len());
+    rest[..end].trim_end().to_string()
+}
+
+#[test]
+fn train_refuses_a_reversing_model_force_records_it_and_eval_scores_the_file() {
+    let dir = tmp("refuse");
+    let session = contradictory_session(&dir);
+    let model = dir.join("ln.hsm");
+    let train = |extra: &[&str]| {
+        let mut args = vec!["train", s(&session), "-o", s(&model), "--model", "ln"];
+        args.extend_from_slice(&["--epochs", "40", "--seed", "2"]);
+        args.extend_from_slice(extra);
+        handctl(&args)
+    };
+    let out = train(&[]);
+    let e = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(4), "{}{e}", text(&out.stdout));
+    assert!(
+        e.contains("model NOT written: the ln model REVERSES:")
+            && e.contains("worst index in trial")
+            && e.contains("--force"),
+        "{e}"
+    );
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("ln.hsm"))
+        .collect();
+    assert!(left.is_empty(), "nothing written, no partial file: {left:?}");
+
+    let out = train(&["--force"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let m = decoder::model::TrainedModel::load(&model, None).unwrap();
+    let v = m.verification().expect("the file records its verification");
+    assert!(v.forced && v.reversing > 0 && v.rays > 0, "{v:?}");
+    assert_eq!(v.method, decoder::model::verify::Method::Exact);
+    let rest = m.rest_rms_uv().expect("the session has rest trials");
+    assert_eq!(rest.len(), 2);
+    // Rest is 5 units of white noise on both channels: band-passed, a little below 5.
+    assert!(rest.iter().all(|&r| (2.0..5.0).contains(&r)), "{rest:?}");
+
+    let out = handctl(&["eval", "--model", s(&model), s(&session)]);
+    let o = text(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        o.contains("its file records: FORCED:") && o.contains("nothing trained"),
+        "{o}"
+    );
+    assert!(o.contains("ln effort-ray check, exact") && o.contains("REVERSES"), "{o}");
+    // One path: the tables of the saved model equal those of `handctl eval` training the
+    // same model (same session, seed and epochs) and testing on the same windows.
+    let trained = handctl(&[
+        "eval",
+        s(&session),
+        "--test",
+        s(&session),
+        "--models",
+        "ln",
+        "--epochs",
+        "40",
+        "--seed",
+        "2",
+    ]);
+    assert!(trained.status.success(), "{}", text(&trained.stderr));
+    assert_eq!(tables(&o), tables(&text(&trained.stdout)));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

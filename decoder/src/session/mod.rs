@@ -15,6 +15,7 @@ mod load;
 mod meta;
 mod npy;
 mod recording;
+mod rest_level;
 mod trial;
 mod windows;
 
