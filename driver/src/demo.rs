@@ -270,7 +270,7 @@ fn certify(
     )?;
     let record = VerificationRecord::from_report(&report, false);
     if !record.passed() {
-        return Err(DemoError::Reverses(format!("{record}\n{report}")));
+        return Err(DemoError::Reverses(record.to_string()));
     }
     let model = model.with_verification(record)?;
     Ok(match windows.rest_rms(trials) {
