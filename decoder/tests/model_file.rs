@@ -294,8 +294,10 @@ fn verification_and_rest_level_round_trip_and_old_files_load() {
     assert!(meta.get("verification").is_none() && meta.get("rest_rms_uv").is_none());
     let back = TrainedModel::from_bytes(&old, Some(&chain(2))).unwrap();
     assert_eq!((back.verification(), back.rest_rms_uv()), (None, None));
-    assert!(decoder::model::verify::describe_verification(back.verification())
-        .starts_with("NOT verified"));
+    assert!(
+        decoder::model::verify::describe_verification(back.verification())
+            .starts_with("NOT verified")
+    );
 
     let full = plain
         .clone()
@@ -353,7 +355,10 @@ fn the_checksum_covers_the_new_sections_and_bad_ones_are_refused() {
     }
     // With the checksum made right, contradictions are still refused, named.
     let bad = [
-        ("verification", serde_json::json!({"forced": true, "reversing": 0})),
+        (
+            "verification",
+            serde_json::json!({"forced": true, "reversing": 0}),
+        ),
         ("verification", serde_json::json!({"reversing": 4000})),
         ("verification", serde_json::json!({"tolerance": -1.0})),
         ("rest_rms_uv", serde_json::json!([1.0])),

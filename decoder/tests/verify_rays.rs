@@ -9,8 +9,8 @@ use decoder::model::verify::{
     DEFAULT_TOLERANCE, SAMPLED_POINTS,
 };
 use decoder::model::{
-    AnyModel, LnSpec, Model, ModelKind, ModelSpec, Normalizer, ResDdSpec, ResDdVariant,
-    Trainable, TrainedModel, TrainingSummary, N_FINGERS,
+    AnyModel, LnSpec, Model, ModelKind, ModelSpec, Normalizer, ResDdSpec, ResDdVariant, Trainable,
+    TrainedModel, TrainingSummary, N_FINGERS,
 };
 use decoder::session::{LabelledWindows, Trial, TrialKind, WindowLabel};
 use proptest::prelude::*;
@@ -170,15 +170,23 @@ fn an_ln_is_exactly_verified_and_can_reverse_through_its_var_weight() {
     features[2] = 1.0;
     let r = v.curves(&features).reversal(0, 1.0);
     assert!((r.amount - 25.0 / 24.0).abs() < 1e-12, "{r:?}");
-    assert!((r.to_k - 5.0 / 12.0).abs() < 1e-12 && r.from_k == 0.0, "{r:?}");
+    assert!(
+        (r.to_k - 5.0 / 12.0).abs() < 1e-12 && r.from_k == 0.0,
+        "{r:?}"
+    );
     let (windows, trials) = one_window(features);
     let report = verify_windows(&mut v, &windows, &trials, DEFAULT_TOLERANCE).unwrap();
     let record = VerificationRecord::from_report(&report, false);
-    assert_eq!((record.rays, record.reversing, record.forced), (5, 5, false));
+    assert_eq!(
+        (record.rays, record.reversing, record.forced),
+        (5, 5, false)
+    );
     let text = record.to_string();
     assert!(
-        text.starts_with("REVERSES: 5 of 5 rays reverse beyond 0.01 (exact); worst thumb in \
-             trial 7 (all flexion, repetition 2) by 1.0417 (effort 0.000 to 0.417)"),
+        text.starts_with(
+            "REVERSES: 5 of 5 rays reverse beyond 0.01 (exact); worst thumb in \
+             trial 7 (all flexion, repetition 2) by 1.0417 (effort 0.000 to 0.417)"
+        ),
         "{text}"
     );
     let forced = VerificationRecord::from_report(&report, true);
@@ -205,7 +213,9 @@ fn mlp_and_cnn_are_verified_by_dense_sampling_and_say_so() {
         assert_eq!(record.method, Method::Sampled(SAMPLED_POINTS));
         let text = record.to_string();
         assert!(
-            text.contains(&format!("(sampled at {SAMPLED_POINTS} efforts, not a proof)")),
+            text.contains(&format!(
+                "(sampled at {SAMPLED_POINTS} efforts, not a proof)"
+            )),
             "{kind}: {text}"
         );
     }

@@ -126,7 +126,10 @@ fn import_train_and_eval_on_the_3dc_proxy() {
 fn counts(line: &str) -> (usize, usize) {
     let words: Vec<&str> = line.split_whitespace().collect();
     let at = words.iter().position(|w| *w == "of").expect("N of M");
-    (words[at - 1].parse().unwrap(), words[at + 1].parse().unwrap())
+    (
+        words[at - 1].parse().unwrap(),
+        words[at + 1].parse().unwrap(),
+    )
 }
 
 #[test]
@@ -407,7 +410,10 @@ fn train_refuses_a_reversing_model_force_records_it_and_eval_scores_the_file() {
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
         .filter(|n| n.contains("ln.hsm"))
         .collect();
-    assert!(left.is_empty(), "nothing written, no partial file: {left:?}");
+    assert!(
+        left.is_empty(),
+        "nothing written, no partial file: {left:?}"
+    );
 
     let out = train(&["--force"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
@@ -432,7 +438,10 @@ fn train_refuses_a_reversing_model_force_records_it_and_eval_scores_the_file() {
         o.contains("its file records: FORCED:") && o.contains("nothing trained"),
         "{o}"
     );
-    assert!(o.contains("ln effort-ray check, exact") && o.contains("REVERSES"), "{o}");
+    assert!(
+        o.contains("ln effort-ray check, exact") && o.contains("REVERSES"),
+        "{o}"
+    );
     // One path: the tables of the saved model equal those of `handctl eval` training the
     // same model (same session, seed and epochs) and testing on the same windows.
     let trained = handctl(&[

@@ -302,9 +302,8 @@ fn with_records(
     verification: Option<VerificationRecord>,
     rest: Option<Vec<f64>>,
 ) -> Result<TrainedModel, FileError> {
-    let malformed = |what: &str, e: super::error::ModelError| {
-        FileError::Malformed(format!("{what}: {e}"))
-    };
+    let malformed =
+        |what: &str, e: super::error::ModelError| FileError::Malformed(format!("{what}: {e}"));
     if let Some(v) = verification {
         model = model
             .with_verification(v)

@@ -74,7 +74,10 @@ impl VerificationRecord {
     pub fn check(&self) -> Result<(), String> {
         let unit = |v: f64| v.is_finite() && (0.0..=1.0).contains(&v);
         if !(self.tolerance.is_finite() && self.tolerance >= 0.0) {
-            return Err(format!("tolerance {} is not finite and >= 0", self.tolerance));
+            return Err(format!(
+                "tolerance {} is not finite and >= 0",
+                self.tolerance
+            ));
         }
         if self.reversing > self.rays {
             return Err(format!(
