@@ -95,6 +95,10 @@ pub struct ModelStatus {
 /// The daemon's answer.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "result", rename_all = "snake_case")]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "one reply per request, built and sent once: boxing the status would save nothing"
+)]
 pub enum Reply {
     /// The request was carried out.
     Ok {
