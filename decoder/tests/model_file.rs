@@ -5,6 +5,7 @@ mod model_support;
 use std::path::PathBuf;
 
 use decoder::dsp::ChainConfig;
+use decoder::model::verify::{Method, VerificationRecord, WorstRay};
 use decoder::model::{
     train, FileError, ModelKind, ModelSpec, TrainConfig, TrainedModel, HEADER_LEN, MAGIC,
 };
@@ -261,4 +262,120 @@ fn io_errors_name_the_path() {
         .save("/nonexistent/dir/model.hsm")
         .unwrap_err();
     assert!(matches!(e, FileError::Io { op: "create", .. }), "{e}");
+}
+
+/// A record as `handctl train --force` writes it for a model that reverses.
+fn forced_record() -> VerificationRecord {
+    VerificationRecord {
+        method: Method::Exact,
+        tolerance: 0.01,
+        rays: 3375,
+        reversing: 12,
+        worst: Some(WorstRay {
+            trial: "trial 3 (index flexion, repetition 1)".into(),
+            finger: 1,
+            amount: 0.0312,
+            from_k: 0.4,
+            to_k: 0.9,
+        }),
+        forced: true,
+    }
+}
+
+#[test]
+fn verification_and_rest_level_round_trip_and_old_files_load() {
+    let plain = trained(ModelKind::ResDd);
+    assert_eq!(plain.verification(), None);
+    assert_eq!(plain.rest_rms_uv(), None);
+    // Without the sections the metadata has neither key: the file is what the writer before
+    // them wrote, and it loads as "not verified".
+    let old = plain.to_bytes().unwrap();
+    let meta = split(&old).meta;
+    assert!(meta.get("verification").is_none() && meta.get("rest_rms_uv").is_none());
+    let back = TrainedModel::from_bytes(&old, Some(&chain(2))).unwrap();
+    assert_eq!((back.verification(), back.rest_rms_uv()), (None, None));
+    assert!(
+        decoder::model::verify::describe_verification(back.verification())
+            .starts_with("NOT verified")
+    );
+
+    let full = plain
+        .clone()
+        .with_verification(forced_record())
+        .unwrap()
+        .with_rest_rms_uv(vec![3.25, 4.5])
+        .unwrap();
+    let bytes = full.to_bytes().unwrap();
+    let back = TrainedModel::from_bytes(&bytes, Some(&chain(2))).unwrap();
+    assert_eq!(back, full);
+    assert_eq!(back.verification(), Some(&forced_record()));
+    assert_eq!(back.rest_rms_uv(), Some(&[3.25, 4.5][..]));
+    let line = back.verification().unwrap().to_string();
+    assert!(
+        line.starts_with("FORCED: 12 of 3375 rays reverse beyond 0.01 (exact)")
+            && line.contains("index in trial 3 (index flexion, repetition 1) by 0.0312"),
+        "{line}"
+    );
+    // The same file with the sections removed from its metadata is the older file.
+    let mut p = split(&bytes);
+    let obj = p.meta.as_object_mut().unwrap();
+    obj.remove("verification");
+    obj.remove("rest_rms_uv");
+    assert_eq!(
+        TrainedModel::from_bytes(&join(&p), Some(&chain(2))).unwrap(),
+        plain
+    );
+}
+
+#[test]
+fn the_checksum_covers_the_new_sections_and_bad_ones_are_refused() {
+    let full = trained(ModelKind::Ln)
+        .with_verification(forced_record())
+        .unwrap()
+        .with_rest_rms_uv(vec![3.25, 4.5])
+        .unwrap();
+    let good = full.to_bytes().unwrap();
+    let load = |b: &[u8]| TrainedModel::from_bytes(b, Some(&chain(2))).unwrap_err();
+    // One value inside each section changed, the checksum left as it was.
+    let find = |hay: &[u8], needle: &str| {
+        hay.windows(needle.len())
+            .position(|w| w == needle.as_bytes())
+            .unwrap_or_else(|| panic!("{needle} is in the file"))
+    };
+    for (key, from, to) in [
+        ("\"verification\"", "\"reversing\": 12", "\"reversing\": 13"),
+        ("\"rest_rms_uv\"", "3.25", "3.75"),
+    ] {
+        let at = find(&good, key);
+        let at = at + find(&good[at..], from);
+        let mut v = good.clone();
+        v[at..at + from.len()].copy_from_slice(to.as_bytes());
+        let e = load(&v);
+        assert!(matches!(e, FileError::BadChecksum { .. }), "{key}: {e}");
+    }
+    // With the checksum made right, contradictions are still refused, named.
+    let bad = [
+        (
+            "verification",
+            serde_json::json!({"forced": true, "reversing": 0}),
+        ),
+        ("verification", serde_json::json!({"reversing": 4000})),
+        ("verification", serde_json::json!({"tolerance": -1.0})),
+        ("rest_rms_uv", serde_json::json!([1.0])),
+        ("rest_rms_uv", serde_json::json!([1.0, -2.0])),
+    ];
+    for (key, patch) in bad {
+        let mut p = split(&good);
+        match (&mut p.meta[key], &patch) {
+            (serde_json::Value::Object(o), serde_json::Value::Object(q)) => {
+                o.extend(q.iter().map(|(k, v)| (k.clone(), v.clone())))
+            }
+            (slot, _) => *slot = patch.clone(),
+        }
+        let e = load(&join(&p));
+        assert!(
+            matches!(e, FileError::Malformed(ref m) if m.contains(key)),
+            "{key} {patch}: {e}"
+        );
+    }
 }

@@ -5,10 +5,11 @@
 use decoder::dsp::{ChainConfig, FEATURES_PER_CHANNEL};
 use decoder::eval::{judge_curve, InterpolationConfig};
 use decoder::model::verify::{
-    eval_polynomial, verify_windows, Method, RayCurves, RayVerifier, DEFAULT_TOLERANCE,
+    eval_polynomial, verify_windows, Method, RayCurves, RayVerifier, VerificationRecord,
+    DEFAULT_TOLERANCE, SAMPLED_POINTS,
 };
 use decoder::model::{
-    AnyModel, Model, ModelKind, ModelSpec, Normalizer, ResDdSpec, ResDdVariant, Trainable,
+    AnyModel, LnSpec, Model, ModelKind, ModelSpec, Normalizer, ResDdSpec, ResDdVariant, Trainable,
     TrainedModel, TrainingSummary, N_FINGERS,
 };
 use decoder::session::{LabelledWindows, Trial, TrialKind, WindowLabel};
@@ -121,6 +122,103 @@ fn a_dip_between_samples_is_missed_by_21_points_and_found_exactly() {
         text.contains("REVERSES trial 7 (all flexion, repetition 2) thumb"),
         "{text}"
     );
+}
+
+/// One flexion window of all five fingers (trial 7) with `features`.
+fn one_window(features: Vec<f64>) -> (LabelledWindows, [Trial; 1]) {
+    let windows = LabelledWindows {
+        n_features: features.len(),
+        features,
+        labels: vec![WindowLabel {
+            trial: 0,
+            targets: [1.0; N_FINGERS],
+            mask: [true; N_FINGERS],
+            end_sample: 0,
+        }],
+    };
+    let trial = Trial {
+        id: 7,
+        finger: None,
+        kind: TrialKind::Flexion,
+        repetition: 2,
+        start_us: 0,
+        end_us: 1,
+    };
+    (windows, [trial])
+}
+
+/// An LN is linear in the features, but VAR grows as `k²`: with RMS weight -5 and VAR weight
+/// 6, every finger's output along the ray through RMS = VAR = 1 is `y = 6k² - 5k`, which
+/// falls to `y(5/12) = -25/24` before it rises to 1. The exact check finds that dip, so an
+/// LN is verified, not assumed monotonic (trained LNs do reverse: see the report).
+#[test]
+fn an_ln_is_exactly_verified_and_can_reverse_through_its_var_weight() {
+    let spec = ModelSpec {
+        ln: LnSpec { hidden: [1, 1] },
+        ..ModelSpec::default()
+    };
+    let mut w1 = vec![0.0; 8];
+    w1[0] = -5.0; // RMS
+    w1[2] = 6.0; // VAR
+    let params = [w1, vec![1.0], vec![1.0; N_FINGERS]].concat();
+    let ln = AnyModel::from_params(ModelKind::Ln, &spec, 8, N_FINGERS, params).unwrap();
+    let model = bundle(ln, spec, Normalizer::identity(8));
+    let mut v = RayVerifier::new(&model);
+    assert_eq!(v.method(), Method::Exact);
+    let mut features = vec![0.0; 8];
+    features[0] = 1.0;
+    features[2] = 1.0;
+    let r = v.curves(&features).reversal(0, 1.0);
+    assert!((r.amount - 25.0 / 24.0).abs() < 1e-12, "{r:?}");
+    assert!(
+        (r.to_k - 5.0 / 12.0).abs() < 1e-12 && r.from_k == 0.0,
+        "{r:?}"
+    );
+    let (windows, trials) = one_window(features);
+    let report = verify_windows(&mut v, &windows, &trials, DEFAULT_TOLERANCE).unwrap();
+    let record = VerificationRecord::from_report(&report, false);
+    assert_eq!(
+        (record.rays, record.reversing, record.forced),
+        (5, 5, false)
+    );
+    let text = record.to_string();
+    assert!(
+        text.starts_with(
+            "REVERSES: 5 of 5 rays reverse beyond 0.01 (exact); worst thumb in \
+             trial 7 (all flexion, repetition 2) by 1.0417 (effort 0.000 to 0.417)"
+        ),
+        "{text}"
+    );
+    let forced = VerificationRecord::from_report(&report, true);
+    assert!(forced.forced && forced.to_string().starts_with("FORCED: 5 of 5"));
+    assert_eq!(forced.check(), Ok(()));
+}
+
+/// MLP and CNN (ReLU) are not polynomials along a ray: they are checked at
+/// [`SAMPLED_POINTS`] efforts and their record says so; a pass is never called exact.
+#[test]
+fn mlp_and_cnn_are_verified_by_dense_sampling_and_say_so() {
+    let n_in = 2 * FEATURES_PER_CHANNEL;
+    let mut rng = ChaCha8Rng::seed_from_u64(4);
+    for kind in [ModelKind::Mlp, ModelKind::Cnn] {
+        let spec = ModelSpec::default();
+        let model = AnyModel::random(kind, &spec, n_in, N_FINGERS, 8).unwrap();
+        let model = bundle(model, spec, Normalizer::identity(n_in));
+        let mut v = RayVerifier::new(&model);
+        assert_eq!(v.method(), Method::Sampled(SAMPLED_POINTS), "{kind}");
+        assert!(RayVerifier::exact(&model).is_err(), "{kind}");
+        let (windows, trials) = one_window(random_features(&mut rng, n_in, false));
+        let report = verify_windows(&mut v, &windows, &trials, DEFAULT_TOLERANCE).unwrap();
+        let record = VerificationRecord::from_report(&report, false);
+        assert_eq!(record.method, Method::Sampled(SAMPLED_POINTS));
+        let text = record.to_string();
+        assert!(
+            text.contains(&format!(
+                "(sampled at {SAMPLED_POINTS} efforts, not a proof)"
+            )),
+            "{kind}: {text}"
+        );
+    }
 }
 
 fn random_features(rng: &mut ChaCha8Rng, n: usize, var_zero: bool) -> Vec<f64> {

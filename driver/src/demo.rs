@@ -1,6 +1,8 @@
 //! The embedded demo (feature `sim`), in one process over the in-memory bus: the simulated patient is
 //! calibrated (rest, maximal flexion and extension of each finger and of the whole hand),
-//! ResDD is trained on that session, then the real daemon loop drives the simulated hand
+//! ResDD is trained on that session and verified as `handctl train` verifies it (every
+//! calibration ray, exactly; a model that reverses beyond the default tolerance is refused, as
+//! `handctl train` refuses it without `--force`), then the real daemon loop drives the simulated hand
 //! while the simulated patient tracks a sine with the index finger. Tracking is scored on the
 //! force the index finger's controller reports (divided by the patient's full-scale force)
 //! against the target, with the paper's RMSE, MAPE and R².
@@ -12,10 +14,13 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use decoder::eval::tracking_metrics;
+use decoder::model::verify::{
+    verify_windows, RayVerifier, VerificationRecord, VerifyError, DEFAULT_TOLERANCE,
+};
 use decoder::model::{
     train, EpochReport, ModelKind, ModelSpec, TrainConfig, TrainedModel, N_FINGERS,
 };
-use decoder::session::{check_gates, GateConfig, Session, WindowOptions};
+use decoder::session::{check_gates, GateConfig, LabelledWindows, Session, WindowOptions};
 use hand_clock::{Clock, SystemClock, VirtualClock};
 use hand_dbc::candump::LogWriter;
 use hand_dbc::messages::FingerStatus;
@@ -82,6 +87,8 @@ pub struct DemoReport {
     pub epochs: usize,
     /// Training time, ms.
     pub train_ms: u64,
+    /// The verification of the model's calibration rays, as its file records it.
+    pub verification: VerificationRecord,
     /// Scored samples (FINGER_STATUS of the index finger, 50 Hz).
     pub samples: usize,
     /// Root mean square error of force/full-scale against the target.
@@ -135,6 +142,16 @@ pub enum DemoError {
     /// Saving the model.
     #[error("model file: {0}")]
     File(#[from] decoder::model::FileError),
+    /// The verification could not run.
+    #[error("verification: {0}")]
+    Verify(#[from] VerifyError),
+    /// The model could not record its verification or rest level.
+    #[error("model: {0}")]
+    Model(#[from] decoder::model::ModelError),
+    /// The trained model goes back against the effort on some calibration ray: refused, as
+    /// `handctl train` refuses it.
+    #[error("the trained model is refused, as handctl train refuses it: {0}")]
+    Reverses(String),
     /// Files.
     #[error("{path}: {source}")]
     Io {
@@ -187,15 +204,11 @@ pub fn record_calibration(dir: &Path, seed: u64) -> Result<usize, DemoError> {
 /// Trains ResDD on the calibration session with the demo's label and training options.
 fn train_resdd(
     session: &Session,
+    windows: &LabelledWindows,
     opts: &DemoOptions,
     on: &mut impl FnMut(DemoEvent<'_>),
 ) -> Result<TrainedModel, DemoError> {
-    let data = session
-        .windows(&WindowOptions {
-            mask_others: opts.mask_others,
-            ..WindowOptions::default()
-        })?
-        .to_dataset(&session.meta.chain)?;
+    let data = windows.to_dataset(&session.meta.chain)?;
     let base = if opts.plain {
         TrainConfig::plain()
     } else {
@@ -232,9 +245,14 @@ pub fn run_demo(
     }
 
     on(DemoEvent::Phase(
-        "training ResDD on the calibration session",
+        "training ResDD on the calibration session and verifying its effort rays",
     ));
-    let model = train_resdd(&session, opts, &mut on)?;
+    let windows = session.windows(&WindowOptions {
+        mask_others: opts.mask_others,
+        ..WindowOptions::default()
+    })?;
+    let model = train_resdd(&session, &windows, opts, &mut on)?;
+    let model = certify(model, &session, &windows, opts.plain)?;
     let model_path = opts.work_dir.join("model.hsm");
     model.save(&model_path)?;
 
@@ -261,12 +279,42 @@ pub fn run_demo(
         trials,
         epochs: s.epochs_run,
         train_ms: s.duration_ms,
+        verification: model.verification().cloned().expect("certify recorded it"),
         samples: scored.len(),
         rmse: m.rmse,
         mape: m.mape,
         r2: m.r2,
         mean_abs_label,
         end,
+    })
+}
+
+/// Verifies every calibration ray of `model` as `handctl train` does (no `--force`: a
+/// reversing model is refused) and records the verification and the calibration's rest level.
+/// Verifies the model's effort rays as `handctl train` does and refuses a reversing model,
+/// unless the demo was asked for the paper's plain training (`paper`), whose reversals are
+/// what it is there to show: that model is kept and its file says FORCED.
+fn certify(
+    model: TrainedModel,
+    session: &Session,
+    windows: &LabelledWindows,
+    paper: bool,
+) -> Result<TrainedModel, DemoError> {
+    let trials = &session.meta.trials;
+    let report = verify_windows(
+        &mut RayVerifier::new(&model),
+        windows,
+        trials,
+        DEFAULT_TOLERANCE,
+    )?;
+    let record = VerificationRecord::from_report(&report, paper);
+    if !record.passed() && !paper {
+        return Err(DemoError::Reverses(record.to_string()));
+    }
+    let model = model.with_verification(record)?;
+    Ok(match windows.rest_rms(trials) {
+        Some(levels) => model.with_rest_rms_uv(levels)?,
+        None => model,
     })
 }
 

@@ -99,11 +99,34 @@ pub struct Status {
     pub lateness: Percentiles,
     /// Per finger, 0 thumb .. 4 pinky.
     pub fingers: Vec<FingerStatus>,
+    /// The model running (absent from a daemon older than this field).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub model: Option<ModelStatus>,
+}
+
+/// The model a daemon runs, as `handctl status` shows it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub struct ModelStatus {
+    /// The model file.
+    pub path: String,
+    /// Its fingerprint as in HAND_HEARTBEAT, 8 hex digits.
+    pub id: String,
+    /// resdd, ln, mlp or cnn.
+    pub kind: String,
+    /// The verification its file records, one line: "verified: 0 of 3375 rays reverse beyond
+    /// 0.01 (exact)", "FORCED: ...", or "NOT verified ...".
+    pub verification: String,
+    /// True when the file records no verification, or one that reverses (forced or not).
+    pub unverified: bool,
 }
 
 /// The daemon's answer.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "result", rename_all = "snake_case")]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "one reply per request, built and sent once: boxing the status would save nothing"
+)]
 pub enum Reply {
     /// The request was carried out.
     Ok {

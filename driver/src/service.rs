@@ -12,7 +12,7 @@ use crate::config::Config;
 use crate::control::Peer;
 use crate::daemon::SharedSnapshot;
 use crate::engine::Command;
-use crate::protocol::{FingerStatus, Reply, Request, Status};
+use crate::protocol::{FingerStatus, ModelStatus, Reply, Request, Status};
 use crate::tuning::{commit_tune, plan_tune, user_name};
 use crate::units::{FINGER_NAMES, N_FINGERS};
 
@@ -26,6 +26,7 @@ pub struct ControlHandler {
     config_path: PathBuf,
     snapshot: SharedSnapshot,
     commands: SyncSender<Command>,
+    model: Option<ModelStatus>,
 }
 
 impl ControlHandler {
@@ -42,7 +43,14 @@ impl ControlHandler {
             config_path,
             snapshot,
             commands,
+            model: None,
         }
+    }
+
+    /// The handler, telling `status` which model runs.
+    pub fn with_model(mut self, model: ModelStatus) -> Self {
+        self.model = Some(model);
+        self
     }
 
     /// The status as `handctl status` shows it.
@@ -69,6 +77,7 @@ impl ControlHandler {
                     kalpha: s.gains[f].kalpha,
                 })
                 .collect(),
+            model: self.model.clone(),
         }
     }
 

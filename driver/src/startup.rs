@@ -110,6 +110,30 @@ pub fn load_model(path: &Path, mains_hz: u32) -> Result<LoadedModel, StartupErro
     })
 }
 
+impl LoadedModel {
+    /// What `handctl status` shows of this model, loaded from `path`.
+    pub fn status(&self, path: &Path) -> crate::protocol::ModelStatus {
+        let v = self.model.verification();
+        crate::protocol::ModelStatus {
+            path: path.display().to_string(),
+            id: format!("{:08x}", self.model_id),
+            kind: self.model.summary().kind.to_string(),
+            verification: decoder::model::verify::describe_verification(v),
+            unverified: !v.is_some_and(|r| r.passed()),
+        }
+    }
+
+    /// Logs the model's verification: info when it passed, a warning otherwise.
+    pub fn log_verification(&self, path: &Path) {
+        let s = self.status(path);
+        if s.unverified {
+            tracing::warn!(model = %s.path, "model {}", s.verification);
+        } else {
+            tracing::info!(model = %s.path, "model {}", s.verification);
+        }
+    }
+}
+
 /// The engine's settings from a validated config.
 pub fn engine_settings(config: &Config, model_id: u32) -> EngineSettings {
     EngineSettings {
@@ -183,6 +207,74 @@ mod tests {
     fn fingerprint_is_fnv1a() {
         assert_eq!(fingerprint(b""), 0x811c_9dc5);
         assert_eq!(fingerprint(b"a"), 0xe40c_292c);
+    }
+
+    /// A random ResDD for the bus's 12 channels at 1 kHz, saved in `dir`, with `record`.
+    fn saved_model(
+        dir: &Path,
+        record: Option<decoder::model::verify::VerificationRecord>,
+    ) -> PathBuf {
+        use decoder::model::{AnyModel, ModelKind, ModelSpec, Normalizer, TrainingSummary};
+        let chain = ChainConfig::default();
+        let n_in = 8 * chain.channels;
+        let spec = ModelSpec::default();
+        let model = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, 1).expect("model");
+        let norm = Normalizer::from_scales(vec![100.0; n_in]).expect("normalizer");
+        let summary = TrainingSummary::untrained(ModelKind::ResDd);
+        let mut m = TrainedModel::new(model, spec, norm, chain, summary).expect("model");
+        if let Some(r) = record {
+            m = m.with_verification(r).expect("a consistent record");
+        }
+        let path = dir.join(format!("model-{}.hsm", m.verification().is_some()));
+        m.save(&path).expect("saved");
+        path
+    }
+
+    #[test]
+    fn the_status_shows_the_model_and_what_its_file_says_of_its_verification() {
+        use decoder::model::verify::{Method, VerificationRecord, WorstRay};
+        let dir = std::env::temp_dir().join(format!("handd-verified-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("scratch directory");
+        let record = VerificationRecord {
+            method: Method::Exact,
+            tolerance: 0.01,
+            rays: 3375,
+            reversing: 0,
+            worst: Some(WorstRay {
+                trial: "trial 3 (index flexion, repetition 1)".into(),
+                finger: 1,
+                amount: 0.002,
+                from_k: 0.5,
+                to_k: 0.6,
+            }),
+            forced: false,
+        };
+        let verified = saved_model(&dir, Some(record));
+        let loaded = load_model(&verified, 50).expect("loads");
+        let s = loaded.status(&verified);
+        assert_eq!(s.kind, "resdd");
+        assert_eq!(s.id, format!("{:08x}", loaded.model_id));
+        assert_eq!(s.path, verified.display().to_string());
+        assert_eq!(
+            s.verification,
+            "verified: 0 of 3375 rays reverse beyond 0.01 (exact)"
+        );
+        assert!(!s.unverified);
+        let (tx, _rx) = std::sync::mpsc::sync_channel(crate::service::COMMAND_QUEUE);
+        let handler = crate::service::ControlHandler::new(
+            Config::default(),
+            dir.join("handd.toml"),
+            Default::default(),
+            tx,
+        )
+        .with_model(s.clone());
+        assert_eq!(handler.status().model, Some(s));
+
+        let old = saved_model(&dir, None);
+        let s = load_model(&old, 50).expect("loads").status(&old);
+        assert!(s.verification.starts_with("NOT verified"), "{s:?}");
+        assert!(s.unverified);
+        std::fs::remove_dir_all(&dir).expect("clean up");
     }
 
     #[test]

@@ -48,5 +48,14 @@ fn demo_calibrates_trains_and_tracks_a_sine() {
     );
     assert_eq!(r.end.counters.deadline_misses, 0);
     assert!(std::fs::metadata(&r.model_path).unwrap().len() > 1000);
+    // The model proved itself before it drove the hand, and its file says so.
+    assert!(
+        r.verification.passed() && !r.verification.forced,
+        "{}",
+        r.verification
+    );
+    let saved = decoder::model::TrainedModel::load(&r.model_path, None).unwrap();
+    assert_eq!(saved.verification(), Some(&r.verification));
+    assert_eq!(saved.rest_rms_uv().map(<[f64]>::len), Some(12));
     std::fs::remove_dir_all(&dir).unwrap();
 }

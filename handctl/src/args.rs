@@ -163,6 +163,14 @@ pub struct TrainArgs {
     pub model: ModelKind,
     #[command(flatten)]
     pub training: TrainingOpts,
+    /// The model is refused (not written) when a finger goes back against the effort by
+    /// more than this on any calibration ray, in label units (full effort is 1).
+    #[arg(long, default_value_t = decoder::model::verify::DEFAULT_TOLERANCE, value_parser = parse_tolerance)]
+    pub tolerance: f64,
+    /// Write the model even when it reverses beyond the tolerance; the file records it as
+    /// FORCED and handd's status says so.
+    #[arg(long)]
+    pub force: bool,
 }
 
 /// `handctl verify`.
@@ -191,11 +199,16 @@ fn parse_tolerance(s: &str) -> Result<f64, String> {
 /// `handctl eval`.
 #[derive(Debug, Args)]
 pub struct EvalArgs {
-    /// Session to train on (and to test on, by its last repetitions, without --test).
+    /// Session to train on (and to test on, by its last repetitions, without --test); with
+    /// --model, the new session to score the saved model on (every window, nothing trained).
     pub session: String,
     /// Models to compare, comma separated.
     #[arg(long, value_delimiter = ',', default_value = "resdd,ln,mlp,cnn", value_parser = parse_kind)]
     pub models: Vec<ModelKind>,
+    /// Score this saved model file on SESSION instead of training: the same tables, and the
+    /// verification of its effort rays on SESSION.
+    #[arg(long, conflicts_with_all = ["models", "test"])]
+    pub model: Option<PathBuf>,
     /// Session to test on; without it the last repetition of every trial kind is held out.
     #[arg(long)]
     pub test: Option<String>,

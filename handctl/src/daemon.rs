@@ -45,9 +45,25 @@ fn done(reply: Reply) -> Result<Option<Status>, CliError> {
     }
 }
 
+/// The model lines of the status: which file runs and what its verification says.
+fn format_model(s: &Status) -> String {
+    match &s.model {
+        Some(m) => format!(
+            "model {} ({}, id {})\n{}{}\n",
+            m.path,
+            m.kind,
+            m.id,
+            if m.unverified { "!! " } else { "" },
+            m.verification
+        ),
+        None => "model: not reported by this handd\n".into(),
+    }
+}
+
 /// The status as a table.
 pub fn format_status(s: &Status) -> String {
-    let mut out = format!(
+    let mut out = format_model(s);
+    out += &format!(
         "state {}   faults {}\n\
          ticks {}   deadline misses {}   EMG samples lost {}   bad frames {}\n\
          latency (newest sample -> setpoints) p50 {} us  p99 {} us  max {} us\n\
@@ -130,4 +146,45 @@ pub fn arm(o: &DaemonOpts) -> Result<(), CliError> {
 /// `handctl stop`.
 pub fn stop(o: &DaemonOpts) -> Result<(), CliError> {
     done(ask(o, &Request::Stop)?).map(drop)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use driver::protocol::ModelStatus;
+
+    #[test]
+    fn status_shows_the_model_and_its_verification() {
+        let model = |verification: &str, unverified| ModelStatus {
+            path: "/var/lib/handstack/model.hsm".into(),
+            id: "0badf00d".into(),
+            kind: "resdd".into(),
+            verification: verification.into(),
+            unverified,
+        };
+        let mut s = Status {
+            model: Some(model(
+                "verified: 0 of 3375 rays reverse beyond 0.01 (exact)",
+                false,
+            )),
+            ..Status::default()
+        };
+        let text = format_status(&s);
+        assert!(
+            text.starts_with(
+                "model /var/lib/handstack/model.hsm (resdd, id 0badf00d)\n\
+                 verified: 0 of 3375 rays reverse beyond 0.01 (exact)\n"
+            ),
+            "{text}"
+        );
+        s.model = Some(model("FORCED: 12 of 3375 rays reverse beyond 0.01", true));
+        assert!(format_status(&s).contains("\n!! FORCED: 12 of 3375"));
+        s.model = None;
+        assert!(format_status(&s).starts_with("model: not reported"));
+        // An older daemon's reply, without the field, still parses.
+        let json = serde_json::to_value(Status::default()).unwrap();
+        assert!(json.get("model").is_none());
+        let back: Status = serde_json::from_value(json).unwrap();
+        assert_eq!(back.model, None);
+    }
 }

@@ -81,6 +81,7 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
         report.epochs,
         report.train_ms as f64 / 1000.0
     );
+    println!("model effort rays: {}", report.verification);
     println!(
         "tracking (index finger, sine amplitude 1, period 4 s, {} samples): RMSE {:.3}  MAPE {}  R² {:.3}",
         report.samples,

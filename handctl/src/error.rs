@@ -64,16 +64,30 @@ pub enum CliError {
     /// Effort rays on which a finger goes back against the effort.
     #[error("{0} effort ray(s) reverse beyond the tolerance (listed above)")]
     Reversals(usize),
+    /// `handctl train` refused to write a model that reverses beyond the tolerance.
+    #[error(
+        "model NOT written: {verdict}. Retrain (another --seed, more --epochs), recalibrate, \
+         or pass --force to write it anyway (the file then records it as FORCED)"
+    )]
+    Refused {
+        /// The verification, naming the worst finger, trial and amount.
+        verdict: String,
+    },
+    /// A model could not be put together (e.g. a record that contradicts itself).
+    #[error("model: {0}")]
+    Model(#[from] decoder::model::ModelError),
     /// The command cannot do what was asked with this data.
     #[error("{0}")]
     Usage(String),
 }
 
 impl CliError {
-    /// Process exit code: 3 for refused quality gates, 1 otherwise.
+    /// Process exit code: 3 for refused quality gates, 4 for a model refused by its
+    /// verification, 1 otherwise.
     pub fn exit_code(&self) -> u8 {
         match self {
             CliError::Gates(_) => 3,
+            CliError::Refused { .. } => 4,
             _ => 1,
         }
     }

@@ -1,6 +1,8 @@
 //! `handctl eval`: train every named model on one session, score all on held-out data, print
 //! the paper's tables and write the curves as CSV, and as PNG figures with the `plots` feature
-//! (the daemon's build links no plotting stack).
+//! (the daemon's build links no plotting stack). With `--model FILE`, no training: the saved
+//! model is scored on every window of the session named, by the same code, and its effort rays
+//! on that session are verified.
 
 use std::path::Path;
 
@@ -8,6 +10,8 @@ use decoder::eval::{
     direction_table, evaluate_model, interpolation_csv, interpolation_table, roc_csv, write_csv,
     InterpolationConfig, ModelEvaluation,
 };
+use decoder::model::verify::{describe_verification, DEFAULT_TOLERANCE};
+use decoder::model::TrainedModel;
 use decoder::session::{LabelledWindows, Session, WindowOptions};
 
 use super::args::EvalArgs;
@@ -61,19 +65,82 @@ fn split(
     }
 }
 
-/// `handctl eval`.
-pub fn run(a: &EvalArgs) -> Result<(), CliError> {
-    let session = Session::open_spec(&a.session)?;
-    gate(&session, &a.training)?;
-    let opts = window_options(&a.training);
-    let (train_w, test_w, what) = split(a, &session, &opts)?;
-    let data = train_w.to_dataset(&session.meta.chain)?;
+/// Creates the `--plots` directory, if one was asked for.
+fn plots_dir(a: &EvalArgs) -> Result<(), CliError> {
     if let Some(dir) = &a.plots {
         std::fs::create_dir_all(dir).map_err(|source| CliError::Io {
             path: dir.display().to_string(),
             source,
         })?;
     }
+    Ok(())
+}
+
+/// Scores `model` on `test`, writing its curves with `--plots`: the one scoring path of both
+/// forms of `handctl eval`.
+fn score(
+    a: &EvalArgs,
+    model: &TrainedModel,
+    test: &LabelledWindows,
+    icfg: &InterpolationConfig,
+) -> Result<ModelEvaluation, CliError> {
+    let e = evaluate_model(model, test, icfg)?;
+    if let Some(dir) = &a.plots {
+        write_plots(dir, &e)?;
+    }
+    Ok(e)
+}
+
+/// Tables 3 and 4 of `evals`, and where the curves went.
+fn print_tables(a: &EvalArgs, evals: &[ModelEvaluation], icfg: &InterpolationConfig) {
+    println!();
+    print!("{}", direction_table(evals));
+    println!();
+    print!("{}", interpolation_table(evals, icfg.tolerance));
+    if let Some(dir) = &a.plots {
+        println!("\n{} in {}", FIGURES, dir.display());
+    }
+}
+
+/// `handctl eval --model FILE SESSION`: the saved model scored on every window of SESSION
+/// (rest included), nothing trained; then its effort rays on SESSION verified.
+fn run_saved(a: &EvalArgs, path: &Path) -> Result<(), CliError> {
+    let session = Session::open_spec(&a.session)?;
+    gate(&session, &a.training)?;
+    let model = TrainedModel::load(path, Some(&session.meta.chain))?;
+    plots_dir(a)?;
+    let test = session.windows(&WindowOptions::default())?;
+    println!(
+        "{} model {} scored on all {} windows of {}, nothing trained",
+        model.summary().kind,
+        path.display(),
+        test.len(),
+        a.session
+    );
+    println!(
+        "its file records: {}",
+        describe_verification(model.verification())
+    );
+    let icfg = InterpolationConfig::default();
+    let e = score(a, &model, &test, &icfg)?;
+    print_tables(a, &[e], &icfg);
+    let r = super::verify::report(&model, &session, &test, DEFAULT_TOLERANCE)?;
+    println!("\nEffort rays of {}:", a.session);
+    print!("{r}");
+    Ok(())
+}
+
+/// `handctl eval`.
+pub fn run(a: &EvalArgs) -> Result<(), CliError> {
+    if let Some(path) = &a.model {
+        return run_saved(a, path);
+    }
+    let session = Session::open_spec(&a.session)?;
+    gate(&session, &a.training)?;
+    let opts = window_options(&a.training);
+    let (train_w, test_w, what) = split(a, &session, &opts)?;
+    let data = train_w.to_dataset(&session.meta.chain)?;
+    plots_dir(a)?;
     println!(
         "{what}; {} training windows, {} test windows{}",
         train_w.len(),
@@ -89,19 +156,9 @@ pub fn run(a: &EvalArgs) -> Result<(), CliError> {
     for &kind in &a.models {
         let model = fit(kind, &data, &a.training)?;
         println!("trained {}", describe(&model));
-        let e = evaluate_model(&model, &test_w, &icfg)?;
-        if let Some(dir) = &a.plots {
-            write_plots(dir, &e)?;
-        }
-        evals.push(e);
+        evals.push(score(a, &model, &test_w, &icfg)?);
     }
-    println!();
-    print!("{}", direction_table(&evals));
-    println!();
-    print!("{}", interpolation_table(&evals, icfg.tolerance));
-    if let Some(dir) = &a.plots {
-        println!("\n{} in {}", FIGURES, dir.display());
-    }
+    print_tables(a, &evals, &icfg);
     Ok(())
 }
 

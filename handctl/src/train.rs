@@ -1,7 +1,7 @@
 //! `handctl train` and `handctl check`.
 
 use decoder::model::{train, Dataset, ModelKind, ModelSpec, TrainConfig, TrainedModel};
-use decoder::session::{check_gates, GateConfig, Session, WindowOptions};
+use decoder::session::{check_gates, GateConfig, LabelledWindows, Session, WindowOptions};
 
 use super::args::{CheckArgs, TrainArgs, TrainingOpts};
 use super::error::CliError;
@@ -84,20 +84,38 @@ pub(super) fn describe(model: &TrainedModel) -> String {
     )
 }
 
-/// `handctl train`.
+/// The session's rest level per channel (see [`TrainedModel::rest_rms_uv`]): from the
+/// training windows, or for a two-point calibration (which trains without rest) from the rest
+/// windows it left out.
+fn rest_level(
+    session: &Session,
+    windows: &LabelledWindows,
+    two_point: bool,
+) -> Result<Option<Vec<f64>>, CliError> {
+    Ok(if two_point {
+        session
+            .windows(&WindowOptions::default())?
+            .rest_rms(&session.meta.trials)
+    } else {
+        windows.rest_rms(&session.meta.trials)
+    })
+}
+
+/// `handctl train`: train, verify every calibration ray, and write the model only if it
+/// passes (or with `--force`, recorded as forced); a refused model leaves no file behind.
 pub fn run(a: &TrainArgs) -> Result<(), CliError> {
     let session = Session::open_spec(&a.session)?;
     gate(&session, &a.training)?;
     let windows = session.windows(&window_options(&a.training))?;
     let data = windows.to_dataset(&session.meta.chain)?;
     let model = fit(a.model, &data, &a.training)?;
-    model.save(&a.output)?;
     println!("{}", describe(&model));
-    let tolerance = decoder::model::verify::DEFAULT_TOLERANCE;
-    println!(
-        "{}",
-        super::verify::after_training(&model, &session, &windows, tolerance)?
-    );
+    let model = super::verify::certify(model, &session, &windows, a.tolerance, a.force)?;
+    let model = match rest_level(&session, &windows, a.training.two_point)? {
+        Some(levels) => model.with_rest_rms_uv(levels)?,
+        None => model,
+    };
+    model.save(&a.output)?;
     println!("wrote {}", a.output.display());
     Ok(())
 }

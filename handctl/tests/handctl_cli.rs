@@ -56,9 +56,13 @@ fn import_train_and_eval_on_the_3dc_proxy() {
         "5",
         "--seed",
         "3",
+        // Five epochs keep this pipeline test fast, not the model monotonic: the verification's
+        // refusal is overridden, and the file and the output say so.
+        "--force",
     ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
-    assert!(text(&out.stdout).contains("wrote"), "{}", text(&out.stdout));
+    let said = format!("{}{}", text(&out.stdout), text(&out.stderr));
+    assert!(said.contains("wrote") && said.contains("FORCED"), "{said}");
     assert!(std::fs::metadata(&model).unwrap().len() > 1000);
     // stderr is a pipe here: no live progress lines.
     assert!(
@@ -122,40 +126,61 @@ fn import_train_and_eval_on_the_3dc_proxy() {
     std::fs::remove_dir_all(&session).unwrap();
 }
 
+/// "REVERSES: N of M rays" / "verified: N of M rays" from a verification line: (N, M).
+fn counts(line: &str) -> (usize, usize) {
+    let words: Vec<&str> = line.split_whitespace().collect();
+    let at = words.iter().position(|w| *w == "of").expect("N of M");
+    (
+        words[at - 1].parse().unwrap(),
+        words[at + 1].parse().unwrap(),
+    )
+}
+
 #[test]
-fn train_then_verify_the_effort_rays() {
+fn train_and_verify_agree_on_the_effort_rays() {
     // Another participant's recordings, named directly: the loader reads the P6_ prefix.
     let spec = format!("3dc:{}/../3dc-armband-p6:test", data_dir().display());
     let dir = tmp("verify");
     std::fs::create_dir_all(&dir).unwrap();
     let model = dir.join("ln.hsm");
-    let out = handctl(&[
-        "train",
-        &spec,
-        "--model",
-        "ln",
-        "-o",
-        s(&model),
-        "--epochs",
-        "3",
-    ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
+    let train = |extra: &[&str]| {
+        let mut args = vec!["train", &spec, "--model", "ln", "-o", s(&model)];
+        args.extend_from_slice(&["--epochs", "3"]);
+        args.extend_from_slice(extra);
+        handctl(&args)
+    };
+    // Three epochs leave an LN that goes back on some rays (its VAR weights make it a
+    // quadratic in the effort): train refuses it and writes nothing.
+    let out = train(&[]);
     let o = text(&out.stdout);
-    assert!(
-        o.contains("effort rays (exact):") && o.contains("training rays"),
-        "{o}"
-    );
-
+    assert_eq!(out.status.code(), Some(4), "{o}{}", text(&out.stderr));
+    assert!(!model.exists());
+    let line = o
+        .lines()
+        .find_map(|l| l.strip_prefix("effort rays of the calibration: REVERSES: "))
+        .unwrap_or_else(|| panic!("the verdict: {o}"));
+    let refused = counts(line);
+    assert!(refused.0 > 0 && refused.1 > refused.0, "{line}");
+    // Written with --force, `handctl verify` on the same session finds the very same rays.
+    let out = train(&["--force"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
     let out = handctl(&["verify", "--model", s(&model), &spec]);
     let o = text(&out.stdout);
     assert!(o.contains("ln effort-ray check, exact"), "{o}");
-    assert!(o.contains("rays checked"), "{o}");
-    let reverses = o.contains("REVERSES");
-    // Exit 0 exactly when no ray reverses; otherwise 1 with the count on stderr.
-    assert_eq!(out.status.code(), Some(if reverses { 1 } else { 0 }), "{o}");
-    if reverses {
-        assert!(text(&out.stderr).contains("reverse beyond the tolerance"));
-    }
+    assert!(o.contains(": FORCED: "), "the file's own record first: {o}");
+    let summary = o
+        .lines()
+        .find(|l| l.contains("rays checked"))
+        .unwrap_or_else(|| panic!("{o}"));
+    assert!(
+        summary.starts_with(&format!(
+            "{} rays checked, {} reverse",
+            refused.1, refused.0
+        )),
+        "train said {refused:?}; verify: {summary}"
+    );
+    assert_eq!(out.status.code(), Some(1), "{o}");
+    assert!(text(&out.stderr).contains("reverse beyond the tolerance"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -259,17 +284,15 @@ fn import_an_npy_recording_with_a_label_table_and_train_on_it() {
         text(&out.stderr)
     );
     let model = dir.join("m.hsm");
-    let out = handctl(&[
-        "train",
-        s(&session),
-        "-o",
-        s(&model),
-        "--model",
-        "ln",
-        "--epochs",
-        "3",
-    ]);
+    // Trained to convergence (an LN of a few epochs still goes back against the effort on
+    // some rays, and train refuses it): it verifies.
+    let out = handctl(&["train", s(&session), "-o", s(&model), "--model", "ln"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        text(&out.stdout).contains("effort rays of the calibration: verified: 0 of "),
+        "{}",
+        text(&out.stdout)
+    );
     assert!(model.exists());
     // A channel count that does not match the file is refused, naming the shape.
     let out = handctl(&[
@@ -311,4 +334,133 @@ fn the_demo_says_how_to_build_it_and_socket_failures_are_not_usage_errors() {
         e.contains("cannot talk to handd") && e.contains("handctl.sock"),
         "{e}"
     );
+}
+
+/// A session no model can fit without going back against the effort: the index finger's
+/// extension is its flexion's very pattern at half the amplitude, so along a flexion ray the
+/// label must pass -1 (at half effort) on its way from 0 to +1. Two channels, rest included.
+fn contradictory_session(dir: &Path) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let plan: [(&str, [f64; 2]); 3] = [
+        ("rest", [5.0, 5.0]),
+        ("flexion", [100.0, 40.0]),
+        ("extension", [50.0, 20.0]),
+    ];
+    let mut samples = Vec::new();
+    let mut labels = String::from("finger,kind,repetition,start_sample,end_sample\n");
+    let mut rng = 11u64;
+    for rep in 1..=2 {
+        for (kind, amps) in plan {
+            let start = samples.len() / 2;
+            for _ in 0..2000 {
+                for a in amps {
+                    samples.push((a * noise(&mut rng)).round());
+                }
+            }
+            let finger = if kind == "rest" { "all" } else { "index" };
+            labels.push_str(&format!("{finger},{kind},{rep},{start},{}\n", start + 2000));
+        }
+    }
+    let npy = dir.join("emg.npy");
+    decoder::session::write_npy_f64(&npy, samples.len() / 2, 2, &samples).unwrap();
+    std::fs::write(dir.join("labels.csv"), labels).unwrap();
+    let session = dir.join("session");
+    let out = handctl(&[
+        "import",
+        "--samples",
+        s(&npy),
+        "--labels",
+        s(&dir.join("labels.csv")),
+        "--channels",
+        "2",
+        "--rows-are-recordings",
+        "-o",
+        s(&session),
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    session
+}
+
+/// The lines of `handctl eval`'s output from Table 3 to the end of Table 4.
+fn tables(stdout: &str) -> String {
+    let from = stdout.find("Table 3").expect("Table 3 printed");
+    let rest = &stdout[from..];
+    let end = rest.find("\nEffort rays").unwrap_or(rest.len());
+    rest[..end].trim_end().to_string()
+}
+
+#[test]
+fn train_refuses_a_reversing_model_force_records_it_and_eval_scores_the_file() {
+    let dir = tmp("refuse");
+    let session = contradictory_session(&dir);
+    let model = dir.join("ln.hsm");
+    let train = |extra: &[&str]| {
+        let mut args = vec!["train", s(&session), "-o", s(&model), "--model", "ln"];
+        args.extend_from_slice(&["--epochs", "40", "--seed", "2"]);
+        args.extend_from_slice(extra);
+        handctl(&args)
+    };
+    let out = train(&[]);
+    let e = text(&out.stderr);
+    assert_eq!(out.status.code(), Some(4), "{}{e}", text(&out.stdout));
+    assert!(
+        e.contains("model NOT written: the ln model REVERSES:")
+            && e.contains("worst index in trial")
+            && e.contains("--force"),
+        "{e}"
+    );
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains("ln.hsm"))
+        .collect();
+    assert!(
+        left.is_empty(),
+        "nothing written, no partial file: {left:?}"
+    );
+
+    let out = train(&["--force"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let m = decoder::model::TrainedModel::load(&model, None).unwrap();
+    let v = m.verification().expect("the file records its verification");
+    assert!(v.forced && v.reversing > 0 && v.rays > 0, "{v:?}");
+    assert_eq!(v.method, decoder::model::verify::Method::Exact);
+    let rest = m.rest_rms_uv().expect("the session has rest trials");
+    assert_eq!(rest.len(), 2);
+    // Rest is white noise uniform in ±5 (RMS 5/√3 = 2.89) on both channels; the 10-450 Hz
+    // band keeps 440/500 of its power at 1 kHz: 2.89·√0.88 = 2.71, within 10%.
+    let expected = 5.0 / 3f64.sqrt() * 0.88f64.sqrt();
+    assert!(
+        rest.iter().all(|&r| (r / expected - 1.0).abs() < 0.1),
+        "{rest:?}, expected about {expected:.2}"
+    );
+
+    let out = handctl(&["eval", "--model", s(&model), s(&session)]);
+    let o = text(&out.stdout);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert!(
+        o.contains("its file records: FORCED:") && o.contains("nothing trained"),
+        "{o}"
+    );
+    assert!(
+        o.contains("ln effort-ray check, exact") && o.contains("REVERSES"),
+        "{o}"
+    );
+    // One path: the tables of the saved model equal those of `handctl eval` training the
+    // same model (same session, seed and epochs) and testing on the same windows.
+    let trained = handctl(&[
+        "eval",
+        s(&session),
+        "--test",
+        s(&session),
+        "--models",
+        "ln",
+        "--epochs",
+        "40",
+        "--seed",
+        "2",
+    ]);
+    assert!(trained.status.success(), "{}", text(&trained.stderr));
+    assert_eq!(tables(&o), tables(&text(&trained.stdout)));
+    std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -7,6 +7,10 @@ pub const FEATURES_PER_CHANNEL: usize = 8;
 pub const FEATURE_NAMES: [&str; FEATURES_PER_CHANNEL] =
     ["RMS", "MAV", "VAR", "SD", "INT", "WL", "DASDV", "DAMV"];
 
+/// Index of RMS within one channel's features.
+pub const RMS_FEATURE: usize = 0;
+const _: () = assert!(matches!(FEATURE_NAMES[RMS_FEATURE].as_bytes(), b"RMS"));
+
 /// The 8 features of one window `x` (at least 2 samples; formulas in the module docs).
 ///
 /// A window shorter than 2 samples has no defined VAR/DASDV/DAMV: all features are 0 then.

@@ -13,7 +13,11 @@
 //! The JSON metadata names everything a reader needs: model kind and hyper-parameters, input and
 //! output sizes, sample rate, channel count, feature names, the full signal chain configuration,
 //! the list of parameter tensors (name and shape, in storage order), the normalizer's shape and
-//! the training summary. Weights are raw IEEE-754 doubles so they load bit for bit.
+//! the training summary; then, when known, the verification of the calibration rays
+//! (`verification`, see [`VerificationRecord`]) and the calibration's rest level per channel
+//! (`rest_rms_uv`). Files written before those two existed have neither and still load ("not
+//! verified"). Everything in the body, these included, is covered by the checksum. Weights are
+//! raw IEEE-754 doubles so they load bit for bit.
 //!
 //! Loading checks, in this order, each with its own [`FileError`]: magic, version, length,
 //! checksum, metadata, tensor shapes against the kind and spec, finite weights, the chain
@@ -36,6 +40,7 @@ use super::spec::ModelSpec;
 use super::summary::TrainingSummary;
 use super::trained::TrainedModel;
 use super::traits::{Model, TensorInfo, Trainable};
+use super::verify::VerificationRecord;
 
 /// Magic bytes at the start of every model file.
 pub const MAGIC: [u8; 8] = *b"HSMODEL\n";
@@ -67,6 +72,12 @@ struct Meta {
     tensors: Vec<TensorMeta>,
     normalizer: TensorMeta,
     summary: TrainingSummary,
+    /// Absent in files written before verification was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    verification: Option<VerificationRecord>,
+    /// Absent in older files, and when the calibration had no rest trials.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    rest_rms_uv: Option<Vec<f64>>,
 }
 
 const FORMAT_NAME: &str = "handstack-model";
@@ -285,6 +296,27 @@ fn check_chain(
     Ok(())
 }
 
+/// Adds the optional sections read from a file, each checked; a bad one is a malformed file.
+fn with_records(
+    mut model: TrainedModel,
+    verification: Option<VerificationRecord>,
+    rest: Option<Vec<f64>>,
+) -> Result<TrainedModel, FileError> {
+    let malformed =
+        |what: &str, e: super::error::ModelError| FileError::Malformed(format!("{what}: {e}"));
+    if let Some(v) = verification {
+        model = model
+            .with_verification(v)
+            .map_err(|e| malformed("verification", e))?;
+    }
+    if let Some(r) = rest {
+        model = model
+            .with_rest_rms_uv(r)
+            .map_err(|e| malformed("rest_rms_uv", e))?;
+    }
+    Ok(model)
+}
+
 impl TrainedModel {
     /// The file contents (see the module docs). Errors only if the model holds a non-finite
     /// value (which its constructors prevent) or the metadata cannot be serialised.
@@ -318,6 +350,8 @@ impl TrainedModel {
                 shape: vec![self.normalizer.len()],
             },
             summary: self.summary.clone(),
+            verification: self.verification.clone(),
+            rest_rms_uv: self.rest_rms_uv.clone(),
         };
         let meta_json =
             serde_json::to_vec_pretty(&meta).map_err(|e| FileError::Malformed(e.to_string()))?;
@@ -359,13 +393,8 @@ impl TrainedModel {
         }
         let model = AnyModel::from_params(meta.kind, &meta.spec, n_in, N_FINGERS, params.to_vec())?;
         let normalizer = Normalizer::from_scales(scales.to_vec())?;
-        Ok(TrainedModel::new(
-            model,
-            meta.spec,
-            normalizer,
-            chain,
-            meta.summary,
-        )?)
+        let trained = TrainedModel::new(model, meta.spec, normalizer, chain, meta.summary)?;
+        with_records(trained, meta.verification, meta.rest_rms_uv)
     }
 
     /// Writes the model atomically ([`crate::fsio::write_atomic`]: a temporary file in the same

@@ -10,8 +10,10 @@ use super::normalizer::Normalizer;
 use super::spec::ModelSpec;
 use super::summary::TrainingSummary;
 use super::traits::{Model, Scratch, Trainable};
+use super::verify::VerificationRecord;
 
-/// Model + normalizer + chain configuration + training summary (what a model file holds).
+/// Model + normalizer + chain configuration + training summary (what a model file holds), and
+/// optionally the verification of its calibration rays and the calibration's rest level.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainedModel {
     pub(crate) model: AnyModel,
@@ -19,6 +21,8 @@ pub struct TrainedModel {
     pub(crate) normalizer: Normalizer,
     pub(crate) chain: ChainConfig,
     pub(crate) summary: TrainingSummary,
+    pub(crate) verification: Option<VerificationRecord>,
+    pub(crate) rest_rms_uv: Option<Vec<f64>>,
 }
 
 impl TrainedModel {
@@ -71,7 +75,42 @@ impl TrainedModel {
             normalizer,
             chain,
             summary,
+            verification: None,
+            rest_rms_uv: None,
         })
+    }
+
+    /// The model with `record` as its verification (replacing any earlier one). Refuses a
+    /// record that contradicts itself ([`VerificationRecord::check`]).
+    pub fn with_verification(mut self, record: VerificationRecord) -> Result<Self, ModelError> {
+        record
+            .check()
+            .map_err(|e| ModelError::InvalidSpec(format!("verification record: {e}")))?;
+        self.verification = Some(record);
+        Ok(self)
+    }
+
+    /// The model with the calibration's rest level per channel (see
+    /// [`TrainedModel::rest_rms_uv`]): one finite, non-negative value per chain channel.
+    pub fn with_rest_rms_uv(mut self, levels: Vec<f64>) -> Result<Self, ModelError> {
+        if levels.len() != self.chain.channels {
+            return Err(ModelError::Shape {
+                what: "rest levels (one per channel)".into(),
+                expected: self.chain.channels,
+                found: levels.len(),
+            });
+        }
+        if let Some((ch, v)) = levels
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !(v.is_finite() && **v >= 0.0))
+        {
+            return Err(ModelError::InvalidSpec(format!(
+                "rest level of channel {ch} is {v}: must be finite and >= 0"
+            )));
+        }
+        self.rest_rms_uv = Some(levels);
+        Ok(self)
     }
 
     /// The model.
@@ -101,6 +140,16 @@ impl TrainedModel {
     /// What training did.
     pub fn summary(&self) -> &TrainingSummary {
         &self.summary
+    }
+    /// The verification of its calibration rays (None: not verified, e.g. an older file).
+    pub fn verification(&self) -> Option<&VerificationRecord> {
+        self.verification.as_ref()
+    }
+    /// Per channel, the calibration session's rest level: the RMS of the band-passed signal
+    /// averaged over its rest windows, in the recording's units (µV for a session recorded
+    /// from the bus). None when the session had no rest trials, or for an older file.
+    pub fn rest_rms_uv(&self) -> Option<&[f64]> {
+        self.rest_rms_uv.as_deref()
     }
 
     /// Labels for one raw feature vector (normalized here). Allocates scratch; for offline use

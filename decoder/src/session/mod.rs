@@ -19,6 +19,7 @@ mod meta;
 mod npy;
 mod recording;
 mod reference;
+mod rest_level;
 mod stream;
 mod table_import;
 mod trial;

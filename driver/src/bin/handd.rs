@@ -95,14 +95,17 @@ fn run(args: &Args) -> Result<(), String> {
         interface = %config.interface,
         "config and model validated"
     );
+    loaded.log_verification(&config.model);
+    let model_status = loaded.status(&config.model);
     if args.check {
         println!(
-            "config {} and model {} ({}, id {:08x}) are valid; interface {}",
+            "config {} and model {} ({}, id {:08x}) are valid; interface {}\nmodel {}",
             args.config.display(),
             config.model.display(),
             loaded.model.model().kind(),
             loaded.model_id,
-            config.interface
+            config.interface,
+            model_status.verification
         );
         return Ok(());
     }
@@ -145,7 +148,8 @@ fn run(args: &Args) -> Result<(), String> {
         .map_err(|e| e.to_string())?
         .with_live(live);
     let mut handler =
-        ControlHandler::new(config.clone(), args.config.clone(), runner.snapshot(), tx);
+        ControlHandler::new(config.clone(), args.config.clone(), runner.snapshot(), tx)
+            .with_model(model_status);
     std::thread::Builder::new()
         .name("handd-control".into())
         .spawn(move || server.serve(move |req, peer| handler.handle(req, peer)))

@@ -300,6 +300,14 @@ fn b_closed_loop_tracks_a_sine_over_vcan() {
     let mut sim = rig.sim("sine", 25.0, &[]);
     sim.wait_success(Duration::from_secs(90));
     let status = rig.cfg.status(&rig.env);
+    // handd tells which model runs and what its file says of its verification: `handctl
+    // train` wrote it without --force, so it passed.
+    let running = status.model.clone().expect("handd reports its model");
+    assert_eq!(running.path, model.display().to_string());
+    assert!(
+        running.verification.starts_with("verified: ") && !running.unverified,
+        "{running:?}"
+    );
     rec.wait_success(Duration::from_secs(30));
     // The analysis reads handctl record's log: the recorder is under test too.
     let log =

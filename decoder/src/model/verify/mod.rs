@@ -8,12 +8,14 @@
 //! the real roots of `y'` in `[0, 1]`, found by Bernstein subdivision (see `roots.rs`: a
 //! root-free interval is proven root-free, never assumed). The models have no output clamp or
 //! squashing, so the polynomial is the output. MLP and CNN (ReLU) are checked by sampling
-//! [`SAMPLED_POINTS`] efforts and say so.
+//! [`SAMPLED_POINTS`] efforts and say so. A model file keeps the outcome as a
+//! [`VerificationRecord`].
 
 mod error;
 mod poly;
 mod propagate;
 mod ray;
+mod record;
 mod report;
 mod reversal;
 mod roots;
@@ -22,6 +24,7 @@ pub use error::VerifyError;
 pub use poly::eval as eval_polynomial;
 pub use propagate::{output_degree, var_index, MAX_DEGREE};
 pub use ray::{RayCurves, RayVerifier, SAMPLED_POINTS};
+pub use record::{describe_verification, VerificationRecord, WorstRay};
 pub use report::{verify_windows, TrialFinger, VerifyReport, DEFAULT_TOLERANCE};
 pub use reversal::{exact_reversal, largest_drop, Method, Reversal};
 pub use roots::{roots_in_unit, Roots, SLOPE_FLOOR, WIDTH_FLOOR};

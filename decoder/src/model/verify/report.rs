@@ -71,11 +71,16 @@ impl VerifyReport {
     pub fn sampled_not_correct(&self) -> usize {
         self.entries.iter().map(|e| e.sampled_not_correct).sum()
     }
-    /// The worst entry, if any ray was checked.
+    /// The worst entry, if any ray was checked (the first of equals, in trial and finger
+    /// order).
     pub fn worst(&self) -> Option<&TrialFinger> {
-        self.entries
-            .iter()
-            .max_by(|a, b| a.worst.amount.total_cmp(&b.worst.amount))
+        self.entries.iter().reduce(|a, b| {
+            if b.worst.amount.total_cmp(&a.worst.amount).is_gt() {
+                b
+            } else {
+                a
+            }
+        })
     }
     /// True when no ray reverses beyond the tolerance.
     pub fn passed(&self) -> bool {

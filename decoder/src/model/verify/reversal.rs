@@ -5,7 +5,8 @@ use super::poly::{derivative, eval};
 use super::roots::roots_in_unit;
 
 /// How a reversal was found.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
 pub enum Method {
     /// From the critical points of the output polynomial: exact up to [`Reversal::bound`].
     Exact,
