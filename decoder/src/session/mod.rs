@@ -21,7 +21,7 @@ mod windows;
 use std::path::{Path, PathBuf};
 
 pub use error::SessionError;
-pub use gates::{check_gates, GateConfig, GateIssue, GateKind, GateReport};
+pub use gates::{check_gates, noisy_against_others, GateConfig, GateIssue, GateKind, GateReport};
 pub use import::{
     import_3dc, import_table, load_3dc, load_label_table, parse_session_spec, SamplesSource,
     SessionSpec, Split, TableImport,

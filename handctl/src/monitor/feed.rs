@@ -1,0 +1,63 @@
+//! One monitor fed by any source: events in, [`MonitorState`] out.
+
+use decoder::dsp::ChainSettings;
+use hand_dbc::CanFrame;
+
+use super::frames::FrameDecoder;
+use super::live::Live;
+use super::state::MonitorState;
+
+/// What a source delivers.
+#[derive(Debug)]
+pub enum Event {
+    /// One line of the daemon's subscription.
+    Live(Box<Live>),
+    /// One frame with its receive time, µs.
+    Frame(u64, CanFrame),
+    /// The source ended, and why.
+    End(String),
+}
+
+/// The state and, for frame sources, the decoder that fills it.
+#[derive(Debug, Clone)]
+pub struct Monitor {
+    /// What is shown.
+    pub state: MonitorState,
+    decoder: FrameDecoder,
+    first_us: Option<u64>,
+}
+
+impl Monitor {
+    /// A monitor titled `source`, decoding EMG with the chain `settings`.
+    pub fn new(source: impl Into<String>, settings: &ChainSettings) -> Self {
+        Self {
+            state: MonitorState::new(source, settings.n_channels()),
+            decoder: FrameDecoder::new(settings),
+            first_us: None,
+        }
+    }
+
+    /// Takes one event.
+    pub fn apply(&mut self, e: Event) {
+        match e {
+            Event::Live(l) => self.state.apply_live(&l),
+            Event::Frame(t, f) => self.decoder.on_frame(&mut self.state, &f, t),
+            Event::End(why) => {
+                if let (Some(t), None) = (self.decoder.last_frame_us(), &self.state.ended) {
+                    // The last values of a log, up to its last frame.
+                    self.decoder.refresh(&mut self.state, t);
+                }
+                self.state.ended = Some(why);
+            }
+        }
+        if self.first_us.is_none() && self.state.t_us > 0 {
+            self.first_us = Some(self.state.t_us);
+        }
+    }
+
+    /// Source time since the first data, s.
+    pub fn elapsed_s(&self) -> f64 {
+        self.first_us
+            .map_or(0.0, |f| self.state.t_us.saturating_sub(f) as f64 * 1e-6)
+    }
+}

@@ -1,0 +1,182 @@
+//! The three sources, each a thread sending [`Event`]s: the daemon's subscription on the
+//! control socket, the bus itself (listen-only), and a recorded candump log at its recorded
+//! speed (or N times it). A log at full speed is read in the caller's thread instead
+//! ([`read_log_fast`]).
+
+use std::fs::File;
+use std::io::{BufRead, BufReader, Write};
+use std::os::unix::net::UnixStream;
+use std::path::{Path, PathBuf};
+use std::sync::mpsc::SyncSender;
+use std::time::{Duration, Instant, UNIX_EPOCH};
+
+use driver::protocol::Reply;
+use hand_dbc::candump::LogReader;
+use hand_dbc::CanFrame;
+use socketcan::{CanSocket, EmbeddedFrame, Socket, SocketOptions};
+
+use super::feed::{Event, Monitor};
+use super::live::Live;
+use crate::error::CliError;
+
+fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> CliError + '_ {
+    move |source| CliError::Io {
+        path: path.display().to_string(),
+        source,
+    }
+}
+
+/// Subscribes on handd's control socket and returns the stream of live lines after handd's
+/// answer; a refusal is an error with handd's reason.
+pub fn subscribe(socket: &Path, every_ms: u64) -> Result<BufReader<UnixStream>, CliError> {
+    let connect = |source| driver::control::ControlError::Connect {
+        path: socket.to_owned(),
+        source,
+    };
+    let mut stream = UnixStream::connect(socket).map_err(connect)?;
+    stream
+        .set_read_timeout(Some(Duration::from_secs(5)))
+        .map_err(connect)?;
+    writeln!(stream, "{{\"cmd\":\"subscribe\",\"every_ms\":{every_ms}}}").map_err(connect)?;
+    let mut reader = BufReader::new(stream);
+    let mut answer = String::new();
+    reader.read_line(&mut answer).map_err(connect)?;
+    match serde_json::from_str::<Reply>(answer.trim()) {
+        Ok(Reply::Ok { .. }) => {}
+        Ok(Reply::Refused { reason }) => {
+            return Err(CliError::Usage(format!(
+                "handd refused the subscription: {reason}"
+            )))
+        }
+        Err(e) => {
+            return Err(CliError::Usage(format!(
+                "handd answered the subscription with {:?}: {e}",
+                answer.trim()
+            )))
+        }
+    }
+    reader.get_ref().set_read_timeout(None).map_err(connect)?;
+    Ok(reader)
+}
+
+/// Sends every live line until handd closes the stream.
+pub fn pump_daemon(mut reader: BufReader<UnixStream>, tx: SyncSender<Event>) {
+    let mut line = String::new();
+    let why = loop {
+        line.clear();
+        match reader.read_line(&mut line) {
+            Ok(0) => break "handd closed the subscription".to_owned(),
+            Ok(_) => {}
+            Err(e) => break format!("reading the subscription failed: {e}"),
+        }
+        match serde_json::from_str::<Live>(line.trim()) {
+            Ok(l) => {
+                if tx.send(Event::Live(Box::new(l))).is_err() {
+                    return;
+                }
+            }
+            Err(e) => break format!("handd sent a line that is not a live snapshot: {e}"),
+        }
+    };
+    let _ = tx.send(Event::End(why));
+}
+
+/// Opens `iface` for reading with kernel receive timestamps. A raw CAN socket that never
+/// writes: the monitor is listen-only on the bus.
+pub fn open_bus(iface: &str) -> Result<CanSocket, CliError> {
+    driver::socketcan_bus::interface_up(iface)?;
+    let bad = |source| CliError::Can {
+        iface: iface.to_owned(),
+        what: "cannot open it".into(),
+        source,
+    };
+    let sock = CanSocket::open(iface).map_err(bad)?;
+    sock.set_recv_timestamp(true).map_err(bad)?;
+    sock.set_read_timeout(Duration::from_millis(100))
+        .map_err(bad)?;
+    Ok(sock)
+}
+
+/// Sends every data frame read from the bus, with its kernel receive time.
+pub fn pump_bus(sock: CanSocket, iface: String, tx: SyncSender<Event>) {
+    let why = loop {
+        let (frame, ts) = match sock.read_frame_with_timestamp() {
+            Ok(x) => x,
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
+                ) =>
+            {
+                continue
+            }
+            Err(e) => break format!("reading {iface} failed: {e}"),
+        };
+        let t = ts
+            .duration_since(UNIX_EPOCH)
+            .map_or(0, |d| d.as_micros() as u64);
+        let ours = match frame {
+            socketcan::CanFrame::Data(d) => CanFrame::new(d.id(), d.data()),
+            _ => None,
+        };
+        if let Some(f) = ours {
+            if tx.send(Event::Frame(t, f)).is_err() {
+                return;
+            }
+        }
+    };
+    let _ = tx.send(Event::End(why));
+}
+
+/// Opens a candump log.
+pub fn open_log(path: &Path) -> Result<LogReader<BufReader<File>>, CliError> {
+    Ok(LogReader::new(BufReader::new(
+        File::open(path).map_err(io_err(path))?,
+    )))
+}
+
+/// Sends a log's frames at `speed` times their recorded pace.
+pub fn pump_log(reader: LogReader<BufReader<File>>, path: PathBuf, speed: f64, tx: SyncSender<Event>) {
+    let start = Instant::now();
+    let mut t0 = None;
+    for entry in reader {
+        let e = match entry {
+            Ok(e) => e,
+            Err(e) => {
+                let _ = tx.send(Event::End(format!("{}: {e}", path.display())));
+                return;
+            }
+        };
+        let t0 = *t0.get_or_insert(e.time_us);
+        let due = Duration::from_secs_f64(e.time_us.saturating_sub(t0) as f64 * 1e-6 / speed);
+        if let Some(wait) = due.checked_sub(start.elapsed()) {
+            std::thread::sleep(wait);
+        }
+        if tx.send(Event::Frame(e.time_us, e.frame)).is_err() {
+            return;
+        }
+    }
+    let _ = tx.send(Event::End("end of the log".into()));
+}
+
+/// Reads a whole log as fast as possible into `m`, stopping after `seconds` of log time;
+/// `on_event` sees the monitor after every event (the plain printer).
+pub fn read_log_fast(
+    path: &Path,
+    m: &mut Monitor,
+    seconds: Option<f64>,
+    mut on_event: impl FnMut(&Monitor),
+) -> Result<(), CliError> {
+    for entry in open_log(path)? {
+        let e = entry.map_err(|e| CliError::Usage(format!("{}: {e}", path.display())))?;
+        m.apply(Event::Frame(e.time_us, e.frame));
+        on_event(m);
+        if seconds.is_some_and(|s| m.elapsed_s() >= s) {
+            m.apply(Event::End(format!("{} s of the log", seconds.unwrap_or(0.0))));
+            return Ok(());
+        }
+    }
+    m.apply(Event::End("end of the log".into()));
+    on_event(m);
+    Ok(())
+}
