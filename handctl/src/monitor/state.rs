@@ -111,6 +111,7 @@ impl History {
     }
 
     /// Points held.
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.points.len()
     }

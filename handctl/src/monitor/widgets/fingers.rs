@@ -21,7 +21,7 @@ pub struct FingerTable<'a> {
 }
 
 /// The header row.
-pub const HEADER: &str = " finger label   F N  v r/s   pos rep N st";
+pub const HEADER: &str = " finger label   F N  v r/s   pos rep N st ";
 
 impl FingerTable<'_> {
     /// The text of one finger's row.
