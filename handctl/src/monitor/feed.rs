@@ -24,7 +24,6 @@ pub struct Monitor {
     /// What is shown.
     pub state: MonitorState,
     decoder: FrameDecoder,
-    first_us: Option<u64>,
 }
 
 impl Monitor {
@@ -33,7 +32,6 @@ impl Monitor {
         Self {
             state: MonitorState::new(source, settings.n_channels()),
             decoder: FrameDecoder::new(settings),
-            first_us: None,
         }
     }
 
@@ -50,14 +48,10 @@ impl Monitor {
                 self.state.ended = Some(why);
             }
         }
-        if self.first_us.is_none() && self.state.t_us > 0 {
-            self.first_us = Some(self.state.t_us);
-        }
     }
 
     /// Source time since the first data, s.
     pub fn elapsed_s(&self) -> f64 {
-        self.first_us
-            .map_or(0.0, |f| self.state.t_us.saturating_sub(f) as f64 * 1e-6)
+        self.state.elapsed_s()
     }
 }

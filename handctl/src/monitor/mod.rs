@@ -69,7 +69,10 @@ pub fn run(a: &MonitorArgs) -> Result<(), CliError> {
     let mut m = match &source {
         Source::Daemon => Monitor::new("daemon", &settings),
         Source::Bus(i) => Monitor::new(format!("bus {i}"), &settings),
-        Source::Log(p) => Monitor::new(format!("log {}", p.display()), &settings),
+        Source::Log(p) => {
+            let name = p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned());
+            Monitor::new(format!("log {name}"), &settings)
+        }
     };
     let mut view = View::with_finger(finger);
     let mut printer = PlainPrinter::default();

@@ -58,7 +58,7 @@ pub fn line(st: &MonitorState, cpu: &CpuMeter) -> String {
     let (c, w) = cpu.used();
     format!(
         "t {:.1} s {} faults {} model {} | latency p50 {} p99 {} us misses {} e2e {} lost {} bus {} | rms uV {rms} | label/F/reported {fingers} | cpu {:.1}%",
-        st.t_us as f64 * 1e-6,
+        st.elapsed_s(),
         d.state.as_deref().unwrap_or("--"),
         if d.faults.is_empty() { "none".to_owned() } else { d.faults.join(",") },
         d.model_id.as_deref().unwrap_or("--"),

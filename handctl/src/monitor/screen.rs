@@ -64,7 +64,7 @@ fn title_line(st: &MonitorState, view: &View) -> Line<'static> {
     Line::from(format!(
         "{} t {:.1} s{status} | <-/-> finger f freeze r reset q quit",
         st.source,
-        st.t_us as f64 * 1e-6
+        st.elapsed_s()
     ))
 }
 

@@ -124,6 +124,8 @@ pub struct MonitorState {
     pub source: String,
     /// Source time of the newest data, µs (the daemon's clock, or the frames' receive times).
     pub t_us: u64,
+    /// Source time of the first refresh, µs: the screen shows time since then.
+    pub first_us: Option<u64>,
     /// Per EMG channel.
     pub channels: Vec<ChannelView>,
     /// Per finger, 0 thumb .. 4 pinky.
@@ -142,6 +144,7 @@ impl MonitorState {
         Self {
             source: source.into(),
             t_us: 0,
+            first_us: None,
             channels: vec![ChannelView::default(); channels],
             fingers: vec![FingerView::default(); N_FINGERS],
             daemon: DaemonView::default(),
@@ -165,8 +168,15 @@ impl MonitorState {
         }
     }
 
+    /// Seconds of data since the first refresh.
+    pub fn elapsed_s(&self) -> f64 {
+        self.first_us
+            .map_or(0.0, |f| self.t_us.saturating_sub(f) as f64 * 1e-6)
+    }
+
     /// One point of the plot at the current time.
     pub fn sample_history(&mut self) {
+        self.first_us.get_or_insert(self.t_us);
         self.history.push(self.t_us, &self.fingers);
     }
 }
