@@ -75,7 +75,9 @@ fn labels(screen: &[String]) -> Vec<f64> {
             let row = screen
                 .iter()
                 .find_map(|r| {
-                    let at = r.find(&format!(" {name} ")).or_else(|| r.find(&format!(">{name} ")))?;
+                    let at = r
+                        .find(&format!(" {name} "))
+                        .or_else(|| r.find(&format!(">{name} ")))?;
                     Some(&r[at + 1..])
                 })
                 .unwrap_or_else(|| panic!("no row for {name}:\n{}", screen.join("\n")));
@@ -87,26 +89,43 @@ fn labels(screen: &[String]) -> Vec<f64> {
         .collect()
 }
 
-#[test]
-fn the_screen_from_a_log_shows_what_scipy_and_cantools_get_from_it() {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("monitor-log-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    let log = dir.join("frames.log");
-    record(&log);
-
+/// The monitor's screen (80x24, from ratatui's test backend) at the end of `log`.
+fn screen_of(log: &std::path::Path) -> Vec<String> {
     let out = Command::new(env!("CARGO_BIN_EXE_handctl"))
-        .args(["monitor", "--log", log.to_str().unwrap(), "--fast", "--screen", "80x24"])
+        .args([
+            "monitor",
+            "--log",
+            log.to_str().unwrap(),
+            "--fast",
+            "--screen",
+            "80x24",
+        ])
         .output()
         .expect("run handctl monitor");
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(out.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let screen: Vec<String> = stdout.lines().take(24).map(str::to_owned).collect();
     println!("{}", screen.join("\n"));
-    assert!(stdout.contains("of a core"), "the CPU use is printed: {stdout}");
+    assert!(
+        stdout.contains("of a core"),
+        "the CPU use is printed: {stdout}"
+    );
 
+    screen
+}
+
+/// The reference's figures for `log`.
+fn reference_of(log: &std::path::Path) -> Value {
     let reference = Command::new(python())
-        .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/ref/monitor_reference.py"))
-        .arg(&log)
+        .arg(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/ref/monitor_reference.py"
+        ))
+        .arg(log)
         .arg(concat!(env!("CARGO_MANIFEST_DIR"), "/../can-dbc/hand.dbc"))
         .output()
         .expect("run the reference");
@@ -115,24 +134,59 @@ fn the_screen_from_a_log_shows_what_scipy_and_cantools_get_from_it() {
         "{}",
         String::from_utf8_lossy(&reference.stderr)
     );
-    let r: Value = serde_json::from_slice(&reference.stdout).expect("JSON");
+    serde_json::from_slice(&reference.stdout).expect("JSON")
+}
+
+fn numbers(v: &Value) -> Vec<f64> {
+    let a = v.as_array().unwrap_or_else(|| panic!("not an array: {v}"));
+    a.iter().map(|x| x.as_f64().expect("a number")).collect()
+}
+
+#[test]
+fn the_screen_from_a_log_shows_what_scipy_and_cantools_get_from_it() {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("monitor-log-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let log = dir.join("frames.log");
+    record(&log);
+
+    let screen = screen_of(&log);
+    let r = reference_of(&log);
     assert!(r["samples"].as_u64().unwrap() > 3500, "{r}");
 
-    let want: Vec<f64> = r["rms_uv"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    let want = numbers(&r["rms_uv"]);
     let got = channel_rms(&screen);
-    assert_eq!(got.len(), 12, "12 channel rows on the screen:\n{}", screen.join("\n"));
+    assert_eq!(
+        got.len(),
+        12,
+        "12 channel rows on the screen:\n{}",
+        screen.join("\n")
+    );
     for (c, (g, w)) in got.iter().zip(&want).enumerate() {
         // One decimal on screen.
-        assert!((g - w).abs() <= 0.05 + 1e-9, "channel {c}: screen {g} µV, scipy {w} µV");
+        assert!(
+            (g - w).abs() <= 0.05 + 1e-9,
+            "channel {c}: screen {g} µV, scipy {w} µV"
+        );
     }
-    assert!(want.iter().any(|&w| w > 5.0), "the log has real EMG: {want:?}");
+    assert!(
+        want.iter().any(|&w| w > 5.0),
+        "the log has real EMG: {want:?}"
+    );
 
-    let want: Vec<f64> = r["labels"].as_array().unwrap().iter().map(|v| v.as_f64().unwrap()).collect();
+    let want = numbers(&r["labels"]);
     let got = labels(&screen);
     for (f, (g, w)) in got.iter().zip(&want).enumerate() {
-        assert!((g - w).abs() < 1e-9, "{}: screen {g}, HAND_DIAG {w}", FINGER_NAMES[f]);
+        assert!(
+            (g - w).abs() < 1e-9,
+            "{}: screen {g}, HAND_DIAG {w}",
+            FINGER_NAMES[f]
+        );
     }
-    assert!(want.iter().any(|&l| l != 0.0), "the daemon decodes something: {want:?}");
+    assert!(
+        want.iter().any(|&l| l != 0.0),
+        "the daemon decodes something: {want:?}"
+    );
     assert!(
         screen.iter().any(|r| r.contains("RUNNING")),
         "the heartbeat's state:\n{}",

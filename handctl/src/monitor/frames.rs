@@ -84,7 +84,8 @@ impl FrameDecoder {
         if t_us >= next {
             self.refresh(st, next);
             // Skip whole periods of silence rather than plotting each.
-            self.next_sample_us = Some(next + SAMPLE_PERIOD_US * ((t_us - next) / SAMPLE_PERIOD_US + 1));
+            self.next_sample_us =
+                Some(next + SAMPLE_PERIOD_US * ((t_us - next) / SAMPLE_PERIOD_US + 1));
         }
         self.last_frame_us = Some(t_us);
         self.load.add(t_us, frame.data().len());
@@ -107,10 +108,14 @@ impl FrameDecoder {
         st.t_us = t_us;
         let features = self.chain.features();
         for (c, v) in st.channels.iter_mut().enumerate() {
-            v.rms_uv = features.get(c * FEATURES_PER_CHANNEL).copied().unwrap_or(0.0);
+            v.rms_uv = features
+                .get(c * FEATURES_PER_CHANNEL)
+                .copied()
+                .unwrap_or(0.0);
         }
         for f in 0..N_FINGERS {
-            let stale = self.last_status_us[f].is_none_or(|s| t_us.saturating_sub(s) > STATUS_STALE_US);
+            let stale =
+                self.last_status_us[f].is_none_or(|s| t_us.saturating_sub(s) > STATUS_STALE_US);
             st.fingers[f].disabled = stale || self.status_disabled[f] || self.setpoint_disabled[f];
         }
         let d = &mut st.daemon;
@@ -161,7 +166,10 @@ impl FrameDecoder {
             Message::HandHeartbeat(m) => {
                 let d = &mut st.daemon;
                 d.state = Some(m.state().dbc_name().to_owned());
-                d.faults = FaultSet(m.fault_mask()).iter().map(|f| f.name().to_owned()).collect();
+                d.faults = FaultSet(m.fault_mask())
+                    .iter()
+                    .map(|f| f.name().to_owned())
+                    .collect();
                 d.model_id = (m.model_id() != 0).then(|| format!("{:08x}", m.model_id()));
             }
             Message::HandDiag(m) => self.on_diag(st, &m),

@@ -129,8 +129,11 @@ impl MonitorState {
         d.state = Some(l.state.clone());
         d.faults.clone_from(&l.faults);
         d.model_id = (!l.model.id.is_empty()).then(|| l.model.id.clone());
-        d.model_detail = (!l.model.kind.is_empty() || !l.model.path.is_empty())
-            .then(|| format!("{} {}", l.model.kind, l.model.path).trim().to_owned());
+        d.model_detail = (!l.model.kind.is_empty() || !l.model.path.is_empty()).then(|| {
+            format!("{} {}", l.model.kind, l.model.path)
+                .trim()
+                .to_owned()
+        });
         d.latency_p50_us = Some(l.latency_us.p50_us);
         d.latency_p99_us = Some(l.latency_us.p99_us);
         d.deadline_misses = l.counters.deadline_misses;
@@ -173,7 +176,10 @@ mod tests {
         assert!(s.fingers[0].active);
         assert_eq!(s.daemon.state.as_deref(), Some("RUNNING"));
         assert_eq!(s.daemon.model_id.as_deref(), Some("1a2b3c4d"));
-        assert_eq!((s.daemon.latency_p50_us, s.daemon.latency_p99_us), (Some(800), Some(1500)));
+        assert_eq!(
+            (s.daemon.latency_p50_us, s.daemon.latency_p99_us),
+            (Some(800), Some(1500))
+        );
         assert_eq!(s.daemon.deadline_misses, 2);
         assert_eq!(s.history.len(), 1);
         assert_eq!(s.t_us, 5_000_000);

@@ -98,7 +98,11 @@ mod tests {
         let load = m.load(2_000_000).expect("two seconds seen");
         assert!((load - 0.405).abs() < 0.001, "{load}");
         assert_eq!(BusLoadMeter::default().load(5), None);
-        assert_eq!(m.load(10_000_000), Some(0.0), "a silent second is an idle bus");
+        assert_eq!(
+            m.load(10_000_000),
+            Some(0.0),
+            "a silent second is an idle bus"
+        );
     }
 
     #[test]

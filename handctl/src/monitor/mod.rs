@@ -70,7 +70,10 @@ pub fn run(a: &MonitorArgs) -> Result<(), CliError> {
         Source::Daemon => Monitor::new("daemon", &settings),
         Source::Bus(i) => Monitor::new(format!("bus {i}"), &settings),
         Source::Log(p) => {
-            let name = p.file_name().map_or_else(|| p.display().to_string(), |n| n.to_string_lossy().into_owned());
+            let name = p.file_name().map_or_else(
+                || p.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            );
             Monitor::new(format!("log {name}"), &settings)
         }
     };

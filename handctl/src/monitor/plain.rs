@@ -49,7 +49,8 @@ pub fn line(st: &MonitorState, cpu: &CpuMeter) -> String {
         format!(
             "{}:{}/{:+.1}/{:+.1}{}",
             &FINGER_NAMES[f][..2],
-            v.label.map_or_else(|| "--".to_owned(), |l| format!("{l:+.2}")),
+            v.label
+                .map_or_else(|| "--".to_owned(), |l| format!("{l:+.2}")),
             v.force_n,
             v.reported_force_n,
             if v.disabled { "!" } else { "" }

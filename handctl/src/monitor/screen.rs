@@ -71,8 +71,8 @@ fn title_line(st: &MonitorState, view: &View) -> Line<'static> {
 /// The screen as text, rendered into ratatui's test backend at `cols` x `rows`: one string per
 /// row, trailing blanks kept.
 pub fn render_text(st: &MonitorState, view: &View, cols: u16, rows: u16) -> Vec<String> {
-    let mut term = Terminal::new(TestBackend::new(cols, rows))
-        .expect("the test backend cannot fail to start");
+    let mut term =
+        Terminal::new(TestBackend::new(cols, rows)).expect("the test backend cannot fail to start");
     term.draw(|f| draw(f, st, view))
         .expect("the test backend cannot fail to draw");
     let buf = term.backend().buffer();

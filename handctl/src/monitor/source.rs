@@ -136,7 +136,12 @@ pub fn open_log(path: &Path) -> Result<LogReader<BufReader<File>>, CliError> {
 }
 
 /// Sends a log's frames at `speed` times their recorded pace.
-pub fn pump_log(reader: LogReader<BufReader<File>>, path: PathBuf, speed: f64, tx: SyncSender<Event>) {
+pub fn pump_log(
+    reader: LogReader<BufReader<File>>,
+    path: PathBuf,
+    speed: f64,
+    tx: SyncSender<Event>,
+) {
     let start = Instant::now();
     let mut t0 = None;
     for entry in reader {
@@ -172,7 +177,10 @@ pub fn read_log_fast(
         m.apply(Event::Frame(e.time_us, e.frame));
         on_event(m);
         if seconds.is_some_and(|s| m.elapsed_s() >= s) {
-            m.apply(Event::End(format!("{} s of the log", seconds.unwrap_or(0.0))));
+            m.apply(Event::End(format!(
+                "{} s of the log",
+                seconds.unwrap_or(0.0)
+            )));
             return Ok(());
         }
     }

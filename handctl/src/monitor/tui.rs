@@ -1,7 +1,7 @@
 //! The terminal UI loop: events from the source as they come, the screen redrawn at 10 Hz,
 //! keys read in between.
 
-use std::sync::mpsc::{Receiver, TryRecvError};
+use std::sync::mpsc::Receiver;
 use std::time::{Duration, Instant};
 
 use ratatui::crossterm::event::{self, Event as TermEvent, KeyCode, KeyEventKind};
@@ -45,11 +45,8 @@ pub fn run(
     let result = (|| {
         let mut next_draw = Instant::now();
         loop {
-            loop {
-                match rx.try_recv() {
-                    Ok(e) => m.apply(e),
-                    Err(TryRecvError::Empty | TryRecvError::Disconnected) => break,
-                }
+            while let Ok(e) = rx.try_recv() {
+                m.apply(e);
             }
             if seconds.is_some_and(|s| m.elapsed_s() >= s) {
                 return Ok(());

@@ -16,6 +16,10 @@ use super::Rig;
 use handstack_tests::vcan::procs::handsim;
 use handstack_tests::vcan::VcanEnv;
 
+fn nz(v: u16) -> std::num::NonZeroU16 {
+    std::num::NonZeroU16::new(v).expect("a screen size above 0")
+}
+
 /// handctl monitor on an 80x24 pseudo-terminal, its screen parsed as it goes.
 struct PtyMonitor {
     child: Child,
@@ -52,7 +56,7 @@ impl PtyMonitor {
             .expect("handctl monitor starts");
         drop(slave);
         let master = File::from(master);
-        let screen = Arc::new(Mutex::new(vt100::Parser::new(24, 80, 0)));
+        let screen = Arc::new(Mutex::new(vt100::Parser::new(nz(24), nz(80), 0)));
         let (mut reader, parser) = (master.try_clone().expect("dup master"), screen.clone());
         std::thread::spawn(move || {
             let mut buf = [0u8; 4096];
@@ -84,7 +88,10 @@ impl PtyMonitor {
             std::thread::sleep(Duration::from_millis(50));
         }
         let _ = self.child.kill();
-        panic!("the monitor did not quit on q; its screen:\n{}", self.contents());
+        panic!(
+            "the monitor did not quit on q; its screen:\n{}",
+            self.contents()
+        );
     }
 }
 
@@ -114,7 +121,7 @@ fn m1_monitor_shows_running_and_the_index_label_changing_sign() {
         }
     }
     let last = mon.quit();
-    let _ = sim.wait_success(Duration::from_secs(30));
+    sim.wait_success(Duration::from_secs(30));
     assert!(running, "the screen never showed RUNNING:\n{last}");
     assert!(
         lo <= -0.1 && hi >= 0.1,
@@ -133,17 +140,27 @@ fn m2_monitor_on_the_bus_without_the_daemon_shows_the_channels() {
     std::thread::sleep(Duration::from_secs(3));
     let s = mon.contents();
     let last = mon.quit();
-    let _ = sim.wait_success(Duration::from_secs(30));
+    sim.wait_success(Duration::from_secs(30));
     assert!(s.contains("no daemon heard"), "{s}");
     let live: Vec<f64> = (0..12)
         .filter_map(|c| {
-            let row = s
-                .lines()
-                .find(|l| l.trim_start_matches('│').trim_start().starts_with(&format!("{c} ")))?;
-            row.trim_start_matches('│').split_whitespace().nth(1)?.parse().ok()
+            let row = s.lines().find(|l| {
+                l.trim_start_matches('│')
+                    .trim_start()
+                    .starts_with(&format!("{c} "))
+            })?;
+            row.trim_start_matches('│')
+                .split_whitespace()
+                .nth(1)?
+                .parse()
+                .ok()
         })
         .collect();
-    assert_eq!(live.len(), 12, "12 channel rows:\n{s}\n(last screen)\n{last}");
+    assert_eq!(
+        live.len(),
+        12,
+        "12 channel rows:\n{s}\n(last screen)\n{last}"
+    );
     assert!(
         live.iter().all(|&v| v > 0.0),
         "every channel of the amplifier shows an amplitude: {live:?}\n{s}"

@@ -22,7 +22,9 @@ pub fn bar_cells(rms_uv: f64, rest_uv: Option<f64>, width: usize) -> String {
         (x.clamp(0.0, 1.0) * width as f64).round() as usize
     };
     let filled = if rms_uv.is_finite() { pos(rms_uv) } else { 0 };
-    let mark = rest_uv.filter(|r| r.is_finite()).map(|r| pos(r).min(width.saturating_sub(1)));
+    let mark = rest_uv
+        .filter(|r| r.is_finite())
+        .map(|r| pos(r).min(width.saturating_sub(1)));
     (0..width)
         .map(|i| match (i < filled, Some(i) == mark) {
             (true, true) => '┃',
@@ -55,7 +57,10 @@ impl ChannelBars<'_> {
         let alarm = v.lead_off || v.saturated || v.noisy;
         Line::from(vec![
             Span::raw(format!("{c:>2} {:>6.1} ", v.rms_uv)),
-            Span::styled(bar_cells(v.rms_uv, v.rest_uv, bar_w), Style::default().fg(Color::Green)),
+            Span::styled(
+                bar_cells(v.rms_uv, v.rest_uv, bar_w),
+                Style::default().fg(Color::Green),
+            ),
             Span::styled(
                 format!(" {flags}"),
                 Style::default().fg(if alarm { Color::Red } else { Color::Reset }),

@@ -26,7 +26,9 @@ pub const HEADER: &str = " finger label   F N  v r/s   pos rep N st ";
 impl FingerTable<'_> {
     /// The text of one finger's row.
     pub fn row(f: usize, v: &FingerView, selected: bool) -> String {
-        let label = v.label.map_or_else(|| "   --".to_owned(), |l| format!("{l:>+5.2}"));
+        let label = v
+            .label
+            .map_or_else(|| "   --".to_owned(), |l| format!("{l:>+5.2}"));
         let st = if v.disabled {
             "OFF"
         } else if v.active {
