@@ -111,7 +111,7 @@ fn screen_of(log: &std::path::Path) -> Vec<String> {
     let screen: Vec<String> = stdout.lines().take(24).map(str::to_owned).collect();
     println!("{}", screen.join("\n"));
     assert!(
-        stdout.contains("of a core"),
+        stdout.contains("monitor used"),
         "the CPU use is printed: {stdout}"
     );
 

@@ -84,7 +84,8 @@ pub fn run(a: &MonitorArgs) -> Result<(), CliError> {
             println!("{}", plain::line(&m.state, &cpu));
         }
     };
-    if let (Source::Log(path), true) = (&source, a.fast || a.speed == 0.0) {
+    let fast = matches!(source, Source::Log(_)) && (a.fast || a.speed == 0.0);
+    if let (Source::Log(path), true) = (&source, fast) {
         source::read_log_fast(path, &mut m, a.seconds, &mut print_plain)?;
     } else {
         let rx = start(&source, a)?;
@@ -102,7 +103,8 @@ pub fn run(a: &MonitorArgs) -> Result<(), CliError> {
     if let Some(why) = &m.state.ended {
         eprintln!("handctl monitor: {why}");
     }
-    println!("{}", cpu.summary(1e6 / frames::SAMPLE_PERIOD_US as f64));
+    let refresh_hz = 1e6 / frames::SAMPLE_PERIOD_US as f64;
+    println!("{}", cpu.summary((!fast).then_some(refresh_hz)));
     Ok(())
 }
 

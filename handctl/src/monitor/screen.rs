@@ -56,13 +56,14 @@ pub fn draw(frame: &mut Frame<'_>, st: &MonitorState, view: &View) {
 }
 
 fn title_line(st: &MonitorState, view: &View) -> Line<'static> {
+    // Why it ended goes to stderr on exit: the title stays within 80 columns.
     let status = match (&st.ended, view.frozen) {
-        (_, true) => " FROZEN".to_owned(),
-        (Some(why), false) => format!(" ENDED: {why}"),
-        (None, false) => String::new(),
+        (_, true) => " FROZEN",
+        (Some(_), false) => " ENDED",
+        (None, false) => "",
     };
     Line::from(format!(
-        "{} t {:.1} s{status} | <-/-> finger f freeze r reset q quit",
+        "{} t {:.1} s{status} | <- -> finger  f freeze  r reset  q quit",
         st.source,
         st.elapsed_s()
     ))
