@@ -188,3 +188,75 @@ pub fn read_log_fast(
     on_event(m);
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use std::os::unix::net::UnixListener;
+    use std::sync::mpsc::sync_channel;
+
+    use super::*;
+
+    /// A one-connection stand-in for handd: checks the request, answers `answer`, then sends
+    /// `lines` and closes.
+    fn fake_handd(name: &str, answer: &'static str, lines: Vec<String>) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("monitor-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("temp dir");
+        let path = dir.join("handctl.sock");
+        let listener = UnixListener::bind(&path).expect("bind");
+        std::thread::spawn(move || {
+            let (stream, _) = listener.accept().expect("accept");
+            let mut reader = BufReader::new(stream.try_clone().expect("dup"));
+            let mut req = String::new();
+            reader.read_line(&mut req).expect("request");
+            let req: serde_json::Value = serde_json::from_str(&req).expect("JSON request");
+            assert_eq!(req["cmd"], "subscribe");
+            assert_eq!(req["every_ms"], 100);
+            let mut w = stream;
+            writeln!(w, "{answer}").expect("answer");
+            for l in lines {
+                writeln!(w, "{l}").expect("line");
+            }
+        });
+        path
+    }
+
+    #[test]
+    fn the_daemon_source_streams_live_lines_until_handd_closes() {
+        let line = |t: u64, state: &str| {
+            format!(
+                r#"{{"t_us":{t},"state":"{state}","fingers":[{{"label":0.25}}],"channels":[{{"rms_uv":7.5}}]}}"#
+            )
+        };
+        let ok = r#"{"result":"ok","message":"subscribed: one line every 100 ms"}"#;
+        let path = fake_handd(
+            "ok",
+            ok,
+            vec![line(1_000_000, "READY"), line(1_100_000, "RUNNING")],
+        );
+        let reader = subscribe(&path, 100).expect("subscribed");
+        let (tx, rx) = sync_channel(16);
+        pump_daemon(reader, tx);
+        let settings = decoder::dsp::ChainConfig::default()
+            .validate()
+            .expect("defaults");
+        let mut m = Monitor::new("daemon", &settings);
+        for e in rx.try_iter() {
+            m.apply(e);
+        }
+        let st = &m.state;
+        assert_eq!(st.daemon.state.as_deref(), Some("RUNNING"));
+        assert_eq!(st.fingers[0].label, Some(0.25));
+        assert_eq!(st.channels[0].rms_uv, 7.5);
+        assert_eq!(st.ended.as_deref(), Some("handd closed the subscription"));
+        assert!((m.elapsed_s() - 0.1).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_refused_subscription_is_an_error_with_handds_reason() {
+        let refused = r#"{"result":"refused","reason":"every_ms 10: at least one tick, 50"}"#;
+        let path = fake_handd("refused", refused, Vec::new());
+        let e = subscribe(&path, 100).expect_err("refused");
+        assert!(e.to_string().contains("at least one tick"), "{e}");
+    }
+}
