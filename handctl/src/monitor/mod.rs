@@ -45,6 +45,23 @@ enum Source {
     Log(std::path::PathBuf),
 }
 
+impl Source {
+    /// The screen's title for the source.
+    fn title(&self) -> String {
+        match self {
+            Source::Daemon => "daemon".into(),
+            Source::Bus(i) => format!("bus {i}"),
+            Source::Log(p) => format!(
+                "log {}",
+                p.file_name().map_or_else(
+                    || p.display().to_string(),
+                    |n| n.to_string_lossy().into_owned()
+                )
+            ),
+        }
+    }
+}
+
 /// `handctl monitor`.
 pub fn run(a: &MonitorArgs) -> Result<(), CliError> {
     let chain = ChainConfig {
@@ -66,17 +83,7 @@ pub fn run(a: &MonitorArgs) -> Result<(), CliError> {
     };
     let cpu = CpuMeter::start();
     let tui = !a.plain && a.screen.is_none() && std::io::stdout().is_terminal();
-    let mut m = match &source {
-        Source::Daemon => Monitor::new("daemon", &settings),
-        Source::Bus(i) => Monitor::new(format!("bus {i}"), &settings),
-        Source::Log(p) => {
-            let name = p.file_name().map_or_else(
-                || p.display().to_string(),
-                |n| n.to_string_lossy().into_owned(),
-            );
-            Monitor::new(format!("log {name}"), &settings)
-        }
-    };
+    let mut m = Monitor::new(source.title(), &settings);
     let mut view = View::with_finger(finger);
     let mut printer = PlainPrinter::default();
     let mut print_plain = |m: &Monitor| {
