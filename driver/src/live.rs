@@ -13,6 +13,7 @@ use crate::units::N_FINGERS;
 
 /// Which model runs.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(default)]
 pub struct ModelInfo {
     /// The model id as HAND_HEARTBEAT carries it (FNV-1a of the file), 8 hex digits.
     pub id: String,
@@ -24,6 +25,7 @@ pub struct ModelInfo {
 
 /// Counters since start.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(default)]
 pub struct Counters {
     /// Ticks that started later than their deadline plus the configured slack.
     pub deadline_misses: u64,
@@ -41,6 +43,7 @@ pub struct Counters {
 
 /// One EMG channel.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default)]
 pub struct ChannelLive {
     /// RMS of the band-passed signal over the window the model last ran on, µV: the daemon's
     /// RMS feature. 0 before the model's first run; it holds its last value while the window
@@ -54,6 +57,7 @@ pub struct ChannelLive {
 
 /// One finger.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default)]
 pub struct FingerLive {
     /// Conditioned label of the last setpoint (0 when stopped).
     pub label: f64,
@@ -73,6 +77,7 @@ pub struct FingerLive {
 
 /// One line of a subscription. See the module docs.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default)]
 pub struct Live {
     /// The tick's deadline on the daemon's clock, µs.
     pub t_us: u64,

@@ -44,6 +44,9 @@ pub enum Command {
     Arm(DaemonOpts),
     /// Safe-stop every finger until `handctl arm`.
     Stop(DaemonOpts),
+    /// The live view of the hand: EMG per channel, fingers, the daemon, a plot; from the
+    /// running daemon (default), the bus (--iface, no daemon needed) or a candump log (--log).
+    Monitor(MonitorArgs),
     /// Record a CAN bus to DIR/frames.log (candump) and, with handsim's trials, a session.
     Record(RecordArgs),
     /// The whole system in one process: calibrate the simulated patient, train ResDD, drive
@@ -87,6 +90,73 @@ pub struct TuneArgs {
     pub kalpha: Option<f64>,
     #[command(flatten)]
     pub daemon: DaemonOpts,
+}
+
+/// `handctl monitor`.
+#[derive(Debug, Args)]
+pub struct MonitorArgs {
+    #[command(flatten)]
+    pub daemon: DaemonOpts,
+    /// Listen to this CAN interface instead of the daemon (listen-only: an electrode check
+    /// before handd runs).
+    #[arg(long, conflicts_with = "log")]
+    pub iface: Option<String>,
+    /// Replay this candump log instead of the daemon.
+    #[arg(long)]
+    pub log: Option<PathBuf>,
+    /// Replay speed of --log, times the recorded pace (0: as fast as possible).
+    #[arg(long, default_value_t = 1.0, value_parser = parse_speed)]
+    pub speed: f64,
+    /// Replay --log as fast as possible (as --speed 0).
+    #[arg(long)]
+    pub fast: bool,
+    /// One line per second of data instead of the screen.
+    #[arg(long)]
+    pub plain: bool,
+    /// Without the live screen: at the end print the screen as text, COLSxROWS (e.g. 80x24).
+    #[arg(long, value_parser = parse_screen)]
+    pub screen: Option<(u16, u16)>,
+    /// Stop after this many seconds of data (source time).
+    #[arg(long, value_parser = parse_positive)]
+    pub seconds: Option<f64>,
+    /// The finger plotted first: thumb, index, middle, ring, pinky (or 0-4).
+    #[arg(long, default_value = "index")]
+    pub finger: String,
+    /// The daemon's subscription period, ms (at least one tick, 50).
+    #[arg(long, default_value_t = 100)]
+    pub every_ms: u64,
+    /// Mains frequency the EMG chain notches for the bus and log sources, 50 or 60 Hz.
+    #[arg(long, default_value_t = 50)]
+    pub mains: u32,
+}
+
+fn parse_speed(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
+    if v.is_finite() && (0.0..=1000.0).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{v}: allowed 0 (as fast as possible) to 1000"))
+    }
+}
+
+fn parse_positive(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
+    if v.is_finite() && v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("{v}: must be a positive number"))
+    }
+}
+
+fn parse_screen(s: &str) -> Result<(u16, u16), String> {
+    let bad = || format!("{s:?}: expected COLSxROWS, at least 80x24 and at most 500x200");
+    let (c, r) = s.split_once(['x', 'X']).ok_or_else(bad)?;
+    let (c, r): (u16, u16) = (c.parse().map_err(|_| bad())?, r.parse().map_err(|_| bad())?);
+    if (80..=500).contains(&c) && (24..=200).contains(&r) {
+        Ok((c, r))
+    } else {
+        Err(bad())
+    }
 }
 
 /// `handctl demo`.

@@ -12,7 +12,7 @@ use super::args::{DaemonOpts, TuneArgs};
 use super::error::CliError;
 
 /// The socket to talk to: `--socket`, else the one named in the config file, else the default.
-fn socket_of(o: &DaemonOpts) -> Result<PathBuf, CliError> {
+pub fn socket_of(o: &DaemonOpts) -> Result<PathBuf, CliError> {
     if let Some(s) = &o.socket {
         return Ok(s.clone());
     }

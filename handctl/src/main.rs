@@ -1,5 +1,6 @@
 //! `handctl`, the technician's command line for the hand: calibration training, evaluation,
-//! importing recordings, decoding them, the running daemon's status, live tuning, arm and stop, and the demo
+//! importing recordings, decoding them, the running daemon's status, live tuning, arm and stop,
+//! the live monitor, and the demo
 //! (with the `sim` feature). One module per subcommand, the argument structures in `args`.
 //!
 //! A crate of its own, beside the daemon's (`driver`): what only the technician's tool needs
@@ -17,6 +18,7 @@ mod demo;
 mod error;
 mod eval;
 mod import;
+mod monitor;
 mod progress;
 mod record;
 mod train;
@@ -45,6 +47,7 @@ fn main() -> ExitCode {
         Command::Tune(a) => daemon::tune(a),
         Command::Arm(o) => daemon::arm(o),
         Command::Stop(o) => daemon::stop(o),
+        Command::Monitor(a) => monitor::run(a),
         Command::Record(a) => record::run(a),
         Command::Demo(a) => run_demo(a),
     };

@@ -114,6 +114,28 @@ impl std::fmt::Display for GateReport {
     }
 }
 
+/// The noisy-electrode rule on per-channel levels (µV or any common unit): channel `channel`
+/// is noisy when its level is above `ratio` times the median of the *other* channels' levels
+/// (the upper median for an even count). Returns that median when the channel is noisy, `None`
+/// when it is not or when there are fewer than two channels. The calibration gate applies it to
+/// the rest trials' levels; `handctl monitor` to the deployed model's rest levels, or to the
+/// live levels when those are unknown.
+pub fn noisy_against_others(levels: &[f64], channel: usize, ratio: f64) -> Option<f64> {
+    let own = *levels.get(channel)?;
+    let mut others: Vec<f64> = levels
+        .iter()
+        .enumerate()
+        .filter(|&(o, _)| o != channel)
+        .map(|(_, &l)| l)
+        .collect();
+    if others.is_empty() {
+        return None;
+    }
+    others.sort_by(f64::total_cmp);
+    let median = others[others.len() / 2];
+    (own > ratio * median).then_some(median)
+}
+
 /// The noisy-electrode gate: `rms[trial][channel]` is the mean windowed RMS, `count[trial]`
 /// its windows.
 fn noisy_at_rest(
@@ -142,10 +164,7 @@ fn noisy_at_rest(
         })
         .collect();
     for (c, &own) in level.iter().enumerate() {
-        let mut others: Vec<f64> = (0..ch).filter(|&o| o != c).map(|o| level[o]).collect();
-        others.sort_by(f64::total_cmp);
-        let median = others[others.len() / 2];
-        if own > config.noisy_ratio * median {
+        if let Some(median) = noisy_against_others(&level, c, config.noisy_ratio) {
             report.issues.push(GateIssue {
                 trial_id: trials[first].id,
                 kind: GateKind::Noisy { channel: c },

@@ -23,6 +23,8 @@ use handstack_tests::vcan::{
 };
 use socketcan::{EmbeddedFrame, Socket};
 
+mod monitor_tui;
+
 /// The daemon's safe-stop bar: setpoints on the bus at most this long after a fault's onset.
 const SAFE_STOP_BAR_US: u64 = 100_000;
 /// Silence timeouts of the drills: 40 ms detection + at most one 50 ms tick stays within the
