@@ -16,13 +16,14 @@ use decoder::model::{train, EpochReport, ModelKind, ModelSpec, TrainConfig, Trai
 use decoder::session::{check_gates, GateConfig, Session, WindowOptions};
 use hand_clock::{Clock, SystemClock, VirtualClock};
 use hand_dbc::candump::LogWriter;
+use hand_dbc::CanFrame;
 use hand_dbc::messages::FingerStatus;
 use hand_model::emg::AmplifierConfig;
 use hand_model::nodes::AmplifierNodeConfig;
 use hand_model::patient::TrackingConfig;
 use hand_model::record::run_on_mem_bus;
 use hand_model::world::{PatientMode, World, WorldConfig};
-use hand_model::{MemBus, Scenario};
+use hand_model::{MemBus, MemEndpoint, Scenario};
 
 use crate::config::Config;
 use crate::daemon::{Runner, Snapshot};
@@ -247,32 +248,47 @@ impl DemoClock for VirtualClock {
 }
 impl DemoClock for SystemClock {}
 
-/// Runs the closed loop; returns (target, tracked) at every index FINGER_STATUS.
-fn track<K: DemoClock>(
+/// The tracking phase's closed loop, ready to run: the simulated world (amplifier, the five
+/// finger controllers, the patient following a sine with one finger) and the daemon's loop
+/// with the default configuration, on one in-memory bus that reads `clock`.
+pub struct ClosedLoop<K: Clock> {
+    /// The simulated hand, amplifier and patient.
+    pub world: World<MemEndpoint<CanFrame>>,
+    /// The daemon's loop (validated, so it runs as soon as EMG arrives).
+    pub runner: Runner<MemTransport<K>, K>,
+    /// The bus (for more endpoints).
+    pub bus: MemBus,
+    /// Start of the loop on `clock`, µs.
+    pub start_us: u64,
+    /// What the patient tracks.
+    pub tracking: TrackingConfig,
+}
+
+/// Builds the [`ClosedLoop`] for `model`; `seed` seeds the patient (and, plus one, the
+/// amplifier's noise).
+pub fn closed_loop<K: Clock + Clone + Send + Sync + 'static>(
     model: &TrainedModel,
-    opts: &DemoOptions,
+    seed: u64,
     clock: K,
-    virtual_time: bool,
-    on: &mut impl FnMut(DemoEvent<'_>),
-) -> Result<(Vec<(f64, f64)>, Snapshot), DemoError> {
+) -> Result<ClosedLoop<K>, DemoError> {
     let tracking = TrackingConfig {
-        seed: opts.seed,
+        seed,
         ..TrackingConfig::default()
     };
     let patient = hand_model::patient::ClosedLoopUser::try_new(tracking)?;
     let bus = MemBus::with_clock(clock.clone());
     let b = bus.clone();
-    let start = clock.now_us();
-    let mut world = World::try_new(
+    let start_us = clock.now_us();
+    let world = World::try_new(
         WorldConfig {
             amplifier: AmplifierNodeConfig {
                 signal: AmplifierConfig {
-                    seed: opts.seed + 1,
+                    seed: seed + 1,
                     ..AmplifierConfig::default()
                 },
                 ..AmplifierNodeConfig::default()
             },
-            start_us: start,
+            start_us,
             ..WorldConfig::default()
         },
         PatientMode::ClosedLoop(Box::new(patient)),
@@ -291,7 +307,31 @@ fn track<K: DemoClock>(
     );
     engine.validated(clock.now_us());
     let transport = MemTransport::new(bus.endpoint(), clock.clone());
-    let mut runner = Runner::new(engine, transport, clock.clone(), config.tick_ms * 1000);
+    let runner = Runner::new(engine, transport, clock, config.tick_ms * 1000);
+    Ok(ClosedLoop {
+        world,
+        runner,
+        bus,
+        start_us,
+        tracking,
+    })
+}
+
+/// Runs the closed loop; returns (target, tracked) at every index FINGER_STATUS.
+fn track<K: DemoClock>(
+    model: &TrainedModel,
+    opts: &DemoOptions,
+    clock: K,
+    virtual_time: bool,
+    on: &mut impl FnMut(DemoEvent<'_>),
+) -> Result<(Vec<(f64, f64)>, Snapshot), DemoError> {
+    let ClosedLoop {
+        mut world,
+        mut runner,
+        bus,
+        start_us: start,
+        tracking,
+    } = closed_loop(model, opts.seed, clock.clone())?;
     let mut probe = bus.endpoint();
     let end = start + (opts.track_s * 1e6) as u64;
     let mut samples = Vec::new();

@@ -40,6 +40,9 @@ use crate::fsio::write_atomic;
 pub const FORMAT_VERSION: u32 = 1;
 /// Name of the metadata file in a session directory.
 pub const META_FILE: &str = "session.toml";
+/// Latest time a session may name, µs (292 000 years): TOML integers are signed 64-bit, so
+/// a later time (e.g. from a huge `end_sample`) could not be written back.
+pub const MAX_TIME_US: u64 = i64::MAX as u64;
 
 /// How the raw signal is stored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -212,10 +215,24 @@ impl SessionMeta {
                 ),
             ));
         }
+        if let Some(fs) = self.recording.full_scale {
+            if !(fs.is_finite() && fs > 0.0) {
+                return Err(SessionError::invalid(
+                    path,
+                    format!("recording.full_scale {fs} must be finite and > 0"),
+                ));
+            }
+        }
         if self.trials.is_empty() {
             return Err(SessionError::invalid(path, "the session has no [[trial]]"));
         }
         for (i, s) in self.segments.iter().enumerate() {
+            if s.end_us > MAX_TIME_US {
+                return Err(SessionError::invalid(
+                    path,
+                    format!("segment {i}: end_us {} is beyond {MAX_TIME_US}", s.end_us),
+                ));
+            }
             if s.end_us <= s.start_us {
                 return Err(SessionError::invalid(
                     path,
@@ -232,6 +249,12 @@ impl SessionMeta {
                 return Err(SessionError::invalid(
                     path,
                     format!("trial id {} appears twice", t.id),
+                ));
+            }
+            if t.end_us > MAX_TIME_US {
+                return Err(SessionError::invalid(
+                    path,
+                    format!("{t}: end {} µs is beyond {MAX_TIME_US} µs", t.end_us),
                 ));
             }
             if t.end_us <= t.start_us {
@@ -304,7 +327,7 @@ impl SessionMeta {
     /// Reads `dir/session.toml`.
     pub fn read(dir: &Path) -> Result<Self, SessionError> {
         let path = dir.join(META_FILE);
-        let text = std::fs::read_to_string(&path).map_err(|e| SessionError::io(&path, e))?;
+        let text = crate::textfile::read_text(&path).map_err(|e| SessionError::io(&path, e))?;
         Self::parse(&text, &path)
     }
 

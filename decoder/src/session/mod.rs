@@ -26,7 +26,9 @@ pub use import::{
     import_3dc, import_table, load_3dc, load_label_table, parse_session_spec, SamplesSource,
     SessionSpec, Split, TableImport,
 };
-pub use meta::{RecordingFormat, RecordingSpec, Segment, SessionMeta, FORMAT_VERSION, META_FILE};
+pub use meta::{
+    RecordingFormat, RecordingSpec, Segment, SessionMeta, FORMAT_VERSION, MAX_TIME_US, META_FILE,
+};
 pub use npy::{npy_f64_bytes, write_npy_f64};
 pub use recording::Recording;
 pub use trial::{Trial, TrialKind, TrialTable, FINGER_NAMES, N_FINGERS};
