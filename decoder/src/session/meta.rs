@@ -251,38 +251,31 @@ impl SessionMeta {
                     format!("trial id {} appears twice", t.id),
                 ));
             }
-            if t.end_us > MAX_TIME_US {
-                return Err(SessionError::invalid(
-                    path,
-                    format!("{t}: end {} µs is beyond {MAX_TIME_US} µs", t.end_us),
-                ));
-            }
-            if t.end_us <= t.start_us {
-                return Err(SessionError::invalid(
-                    path,
-                    format!(
-                        "{t}: end {} µs is not after start {} µs",
-                        t.end_us, t.start_us
-                    ),
-                ));
-            }
-            if let Some(f) = t.finger {
-                if f >= N_FINGERS {
-                    return Err(SessionError::invalid(
-                        path,
-                        format!("{t}: finger {f} is not 0..4"),
-                    ));
-                }
-            }
-            if !self.segments.is_empty() && self.segment_of(t).is_none() {
-                return Err(SessionError::invalid(
-                    path,
-                    format!(
-                        "{t} ({}..{} µs) does not lie inside one [[segment]]",
-                        t.start_us, t.end_us
-                    ),
-                ));
-            }
+            self.check_trial(t)
+                .map_err(|m| SessionError::invalid(path, m))?;
+        }
+        Ok(())
+    }
+
+    /// What is wrong with one trial's times and finger, if anything.
+    fn check_trial(&self, t: &Trial) -> Result<(), String> {
+        if t.end_us > MAX_TIME_US {
+            return Err(format!("{t}: end {} µs is beyond {MAX_TIME_US} µs", t.end_us));
+        }
+        if t.end_us <= t.start_us {
+            return Err(format!(
+                "{t}: end {} µs is not after start {} µs",
+                t.end_us, t.start_us
+            ));
+        }
+        if let Some(f) = t.finger.filter(|&f| f >= N_FINGERS) {
+            return Err(format!("{t}: finger {f} is not 0..4"));
+        }
+        if !self.segments.is_empty() && self.segment_of(t).is_none() {
+            return Err(format!(
+                "{t} ({}..{} µs) does not lie inside one [[segment]]",
+                t.start_us, t.end_us
+            ));
         }
         Ok(())
     }
