@@ -226,7 +226,9 @@ impl<R: BufRead> LogReader<R> {
     fn read_bounded_line(&mut self) -> io::Result<bool> {
         self.buf.clear();
         let limit = (MAX_LINE_BYTES + 1) as u64;
-        let n = (&mut self.input).take(limit).read_until(b'\n', &mut self.buf)?;
+        let n = (&mut self.input)
+            .take(limit)
+            .read_until(b'\n', &mut self.buf)?;
         if n == 0 {
             return Ok(false);
         }
@@ -461,8 +463,14 @@ mod hostile_input {
         let mut reader = LogReader::new(text.as_bytes());
         assert!(reader.next().expect("line 1").is_ok());
         let err = reader.next().expect("line 2").expect_err("too long");
-        assert_eq!(err.to_string(), "line 2: line longer than 256 bytes: not a candump line");
-        let third = reader.next().expect("line 3").expect("the next line is read whole");
+        assert_eq!(
+            err.to_string(),
+            "line 2: line longer than 256 bytes: not a candump line"
+        );
+        let third = reader
+            .next()
+            .expect("line 3")
+            .expect("the next line is read whole");
         assert_eq!(third.frame.raw_id(), 0x124);
         assert!(reader.next().is_none());
         // The longest line accepted, with and without a final newline.

@@ -9,7 +9,10 @@ pub fn first_non_utf8(bytes: &[u8]) -> Option<(usize, usize)> {
     let at = std::str::from_utf8(bytes).err()?.valid_up_to();
     let before = &bytes[..at];
     let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
-    let line_start = before.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+    let line_start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |i| i + 1);
     Some((line, at - line_start + 1))
 }
 

@@ -287,7 +287,10 @@ fn fields_that_size_memory_are_bounded_first() {
         ..ChainConfig::default()
     });
     assert_eq!(e, ConfigError::Harmonics(u32::MAX));
-    assert!(msg.contains("mains_harmonics = 4294967295: must be at most 20"), "{msg}");
+    assert!(
+        msg.contains("mains_harmonics = 4294967295: must be at most 20"),
+        "{msg}"
+    );
     ChainConfig {
         sample_rate_hz: 10_000.0,
         mains_harmonics: MAX_HARMONICS,
@@ -300,11 +303,23 @@ fn fields_that_size_memory_are_bounded_first() {
         window_ms: MAX_WINDOW_SAMPLES as f64,
         ..ChainConfig::default()
     };
-    assert_eq!(longest.validate().expect("65536 samples").window_len(), 65_536);
+    assert_eq!(
+        longest.validate().expect("65536 samples").window_len(),
+        65_536
+    );
     let (e, msg) = err(ChainConfig {
         window_ms: (MAX_WINDOW_SAMPLES + 1) as f64,
         ..ChainConfig::default()
     });
-    assert!(matches!(e, ConfigError::Timing { field: "window_ms", .. }), "{e:?}");
+    assert!(
+        matches!(
+            e,
+            ConfigError::Timing {
+                field: "window_ms",
+                ..
+            }
+        ),
+        "{e:?}"
+    );
     assert!(msg.contains("at most 65536 samples"), "{msg}");
 }

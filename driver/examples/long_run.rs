@@ -62,10 +62,20 @@ fn train_model(dir: &Path) -> Result<(), Error> {
         seed: 1,
         ..TrainConfig::default()
     };
-    let model = train(ModelKind::ResDd, &ModelSpec::default(), &data, &cfg, &mut |_| {})?;
+    let model = train(
+        ModelKind::ResDd,
+        &ModelSpec::default(),
+        &data,
+        &cfg,
+        &mut |_| {},
+    )?;
     let path = dir.join("model.hsm");
     model.save(&path)?;
-    println!("trained ResDD on {}: {}", session_dir.display(), path.display());
+    println!(
+        "trained ResDD on {}: {}",
+        session_dir.display(),
+        path.display()
+    );
     Ok(())
 }
 
@@ -74,7 +84,7 @@ fn run(model: &TrainedModel, minutes: f64) -> Result<(Vec<Sample>, DaemonEnd), E
     let clock = SystemClock::new();
     let ClosedLoop {
         mut world, runner, ..
-    } = closed_loop(model, 1, clock.clone())?;
+    } = closed_loop(model, 1, clock)?;
     let snapshot = runner.snapshot();
     let stop = Arc::new(AtomicBool::new(false));
     let cpu_ns = Arc::new(AtomicU64::new(0));
@@ -112,7 +122,9 @@ fn run(model: &TrainedModel, minutes: f64) -> Result<(Vec<Sample>, DaemonEnd), E
             next_sample += Duration::from_secs(1);
         }
         let next_ms = (clock.now_us() / 1000 + 1) * 1000;
-        std::thread::sleep(Duration::from_micros(next_ms.saturating_sub(clock.now_us())));
+        std::thread::sleep(Duration::from_micros(
+            next_ms.saturating_sub(clock.now_us()),
+        ));
     }
     stop.store(true, Ordering::Relaxed);
     let end = daemon.join().map_err(|_| "the daemon thread panicked")?;
@@ -158,7 +170,7 @@ fn table(samples: &[Sample]) -> String {
     );
     let mut prev = &samples[0];
     for (i, s) in samples.iter().enumerate().skip(1) {
-        if (s.t_s as u64) % 60 == 0 || i == samples.len() - 1 {
+        if (s.t_s as u64).is_multiple_of(60) || i == samples.len() - 1 {
             out += &row(s, prev);
             out.push('\n');
             prev = s;
@@ -174,7 +186,9 @@ fn report(samples: &[Sample], end: &DaemonEnd) -> String {
     let (lo, hi) = samples
         .iter()
         .filter(|s| s.t_s >= warm.t_s)
-        .fold((u64::MAX, 0), |(lo, hi), s| (lo.min(s.rss_kb), hi.max(s.rss_kb)));
+        .fold((u64::MAX, 0), |(lo, hi), s| {
+            (lo.min(s.rss_kb), hi.max(s.rss_kb))
+        });
     let c = &last.snap.counters;
     let cpu = last.daemon_cpu_ns as f64 / (last.t_s * 1e9) * 100.0;
     let lost = end.overflows + c.samples_lost + c.bad_frames + c.e2e_errors;

@@ -16,8 +16,8 @@ use decoder::model::{train, EpochReport, ModelKind, ModelSpec, TrainConfig, Trai
 use decoder::session::{check_gates, GateConfig, Session, WindowOptions};
 use hand_clock::{Clock, SystemClock, VirtualClock};
 use hand_dbc::candump::LogWriter;
-use hand_dbc::CanFrame;
 use hand_dbc::messages::FingerStatus;
+use hand_dbc::CanFrame;
 use hand_model::emg::AmplifierConfig;
 use hand_model::nodes::AmplifierNodeConfig;
 use hand_model::patient::TrackingConfig;

@@ -81,7 +81,9 @@ fn main() {
         (
             "a tensor shape of 2^40 elements",
             join(
-                &edit(&p.meta, |v| v["tensors"][0]["shape"][0] = (1u64 << 40).into()),
+                &edit(&p.meta, |v| {
+                    v["tensors"][0]["shape"][0] = (1u64 << 40).into()
+                }),
                 &p.data,
             ),
             "wrong shape for w_in",

@@ -211,7 +211,10 @@ mod tests {
     fn a_shape_whose_size_overflows_is_refused() {
         let huge = npy("<f8", "(4294967296, 4294967296, 2)", &[0u8; 8]);
         let err = parse_npy(&huge).expect_err("overflowing shape").to_string();
-        assert!(err.contains("shape [4294967296, 4294967296, 2] is too large"), "{err}");
+        assert!(
+            err.contains("shape [4294967296, 4294967296, 2] is too large"),
+            "{err}"
+        );
         let big = npy("<i2", "(1099511627776, 12)", &[0u8; 24]);
         let err = parse_npy(&big).expect_err("claims 2**40 rows").to_string();
         assert!(err.contains("needs 26388279066624"), "{err}");

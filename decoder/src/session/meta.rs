@@ -260,7 +260,10 @@ impl SessionMeta {
     /// What is wrong with one trial's times and finger, if anything.
     fn check_trial(&self, t: &Trial) -> Result<(), String> {
         if t.end_us > MAX_TIME_US {
-            return Err(format!("{t}: end {} µs is beyond {MAX_TIME_US} µs", t.end_us));
+            return Err(format!(
+                "{t}: end {} µs is beyond {MAX_TIME_US} µs",
+                t.end_us
+            ));
         }
         if t.end_us <= t.start_us {
             return Err(format!(

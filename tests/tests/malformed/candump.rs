@@ -20,7 +20,10 @@ fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
         match item {
             Ok(entry) => prop_assert_eq!(parse_line(&format_line(&entry)), Ok(entry)),
             Err(CandumpError::Line { line, error }) => {
-                prop_assert!((1..=lines).contains(&line), "line {line} of {lines}: {error}");
+                prop_assert!(
+                    (1..=lines).contains(&line),
+                    "line {line} of {lines}: {error}"
+                );
                 let msg = CandumpError::Line { line, error }.to_string();
                 prop_assert!(msg.starts_with(&format!("line {line}: ")), "{msg}");
             }
@@ -45,7 +48,10 @@ fn a_log_without_newlines_is_refused_at_line_1_without_buffering_it() {
         .next()
         .expect("one item")
         .expect_err("not a line");
-    assert_eq!(err.to_string(), "line 1: line longer than 256 bytes: not a candump line");
+    assert_eq!(
+        err.to_string(),
+        "line 1: line longer than 256 bytes: not a candump line"
+    );
 }
 
 proptest! {

@@ -17,7 +17,10 @@ const VALID: &[&str] = &[
 /// object loses its position and field (e.g. `"kf":"x"` gives "invalid type: string \"x\",
 /// expected f64"). Fixing it belongs to `driver::protocol::parse_request` (reported as a
 /// follow-up); everything else must name a column or a field.
-const KNOWN_GAPS: &[&str] = &["malformed request: invalid type: ", "malformed request: invalid value: "];
+const KNOWN_GAPS: &[&str] = &[
+    "malformed request: invalid type: ",
+    "malformed request: invalid value: ",
+];
 
 fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
     let line = String::from_utf8_lossy(bytes);
@@ -42,11 +45,21 @@ fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
 #[test]
 fn the_valid_lines_parse_and_deep_nesting_is_refused() {
     for line in VALID {
-        assert!(matches!(parse_request(line), Ok(Request::Tune { .. } | Request::Status)));
+        assert!(matches!(
+            parse_request(line),
+            Ok(Request::Tune { .. } | Request::Status)
+        ));
     }
-    let deep = format!(r#"{{"cmd":"status","x":{}{}}}"#, "[".repeat(2000), "]".repeat(2000));
+    let deep = format!(
+        r#"{{"cmd":"status","x":{}{}}}"#,
+        "[".repeat(2000),
+        "]".repeat(2000)
+    );
     let reason = parse_request(&deep).expect_err("too deep");
-    assert!(reason.contains("recursion limit") && reason.contains("column"), "{reason}");
+    assert!(
+        reason.contains("recursion limit") && reason.contains("column"),
+        "{reason}"
+    );
 }
 
 proptest! {

@@ -97,7 +97,11 @@ fn a_file_that_is_not_text_is_refused_with_line_and_column() {
     std::fs::write(&path, &bytes).expect("write");
     let err = Config::load(&path).expect_err("not text");
     std::fs::remove_file(&path).expect("clean up");
-    assert!(err.to_string().ends_with("not UTF-8 text at line 3, column 1"), "{err}");
+    assert!(
+        err.to_string()
+            .ends_with("not UTF-8 text at line 3, column 1"),
+        "{err}"
+    );
 }
 
 proptest! {

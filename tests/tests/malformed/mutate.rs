@@ -67,7 +67,11 @@ fn number_spans(bytes: &[u8]) -> Vec<(usize, usize)> {
     let mut i = 0;
     while i < bytes.len() {
         if bytes[i].is_ascii_digit() {
-            let start = if i > 0 && bytes[i - 1] == b'-' { i - 1 } else { i };
+            let start = if i > 0 && bytes[i - 1] == b'-' {
+                i - 1
+            } else {
+                i
+            };
             let mut end = i;
             while end < bytes.len() && (bytes[end].is_ascii_digit() || b".eE".contains(&bytes[end]))
             {
@@ -140,9 +144,7 @@ impl Mutation {
 
 /// Bytes that are likely to matter in text formats, mixed with arbitrary ones.
 fn inserted_bytes() -> impl Strategy<Value = Vec<u8>> {
-    let text = prop::sample::select(
-        b"\n\r\t #=[]{}\",.:-_()0123456789eE\xff\x00\\'ntfR".to_vec(),
-    );
+    let text = prop::sample::select(b"\n\r\t #=[]{}\",.:-_()0123456789eE\xff\x00\\'ntfR".to_vec());
     prop::collection::vec(prop_oneof![3 => text, 1 => any::<u8>()], 1..12)
 }
 

@@ -95,7 +95,10 @@ fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
         Err(SessionError::Chain(e)) => {
             let msg = e.to_string();
             let field = msg.split(" = ").next().unwrap_or_default();
-            prop_assert!(CHAIN_FIELDS.contains(&field), "chain error names no field: {msg}");
+            prop_assert!(
+                CHAIN_FIELDS.contains(&field),
+                "chain error names no field: {msg}"
+            );
         }
         Err(other) => prop_assert!(false, "unexpected kind of error: {other}"),
     }
@@ -106,7 +109,10 @@ fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
 fn the_valid_file_parses() {
     let meta = SessionMeta::parse(VALID, Path::new("session.toml")).expect("valid");
     assert_eq!(meta.trials.len(), 2);
-    assert_eq!((meta.trials[1].start_us, meta.trials[1].end_us), (4_000_000, 4_900_000));
+    assert_eq!(
+        (meta.trials[1].start_us, meta.trials[1].end_us),
+        (4_000_000, 4_900_000)
+    );
 }
 
 #[test]
@@ -153,7 +159,10 @@ fn a_time_beyond_tomls_integers_is_refused() {
     let text = edited("end_sample = 4900", "end_sample = 9223372036854775807");
     let err = SessionMeta::parse(&text, Path::new("session.toml")).expect_err("too late");
     let msg = err.to_string();
-    assert!(msg.contains("trial 2") && msg.contains("is beyond 9223372036854775807"), "{msg}");
+    assert!(
+        msg.contains("trial 2") && msg.contains("is beyond 9223372036854775807"),
+        "{msg}"
+    );
     // The largest time accepted is written back and read again unchanged.
     let text = edited("end_us = 4000000", "end_us = 9223372036854775807")
         .replace("end_us = 5000000", "end_us = 9223372036854775807");
@@ -174,5 +183,8 @@ fn a_file_that_is_not_text_is_refused_with_line_and_column() {
     let err = SessionMeta::read(&dir).expect_err("not text");
     std::fs::remove_dir_all(&dir).expect("clean up");
     let msg = err.to_string();
-    assert!(msg.contains("session.toml: not UTF-8 text at line 1, column 3"), "{msg}");
+    assert!(
+        msg.contains("session.toml: not UTF-8 text at line 1, column 3"),
+        "{msg}"
+    );
 }
