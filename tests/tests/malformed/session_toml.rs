@@ -49,6 +49,11 @@ start_sample = 4000
 end_sample = 4900
 "#;
 
+/// `VALID` without its `[[segment]]` (the whole recording is one).
+fn without_segments() -> Vec<u8> {
+    edited("[[segment]]\nstart_us = 0\nend_us = 5000000\n\n", "").into_bytes()
+}
+
 /// The chain configuration's fields, which its errors start with.
 const CHAIN_FIELDS: &[&str] = &[
     "channels",
@@ -131,7 +136,9 @@ proptest! {
     }
 
     #[test]
-    fn mutated_files_never_panic(bytes in mutated(VALID.as_bytes().to_vec())) {
+    fn mutated_files_never_panic(
+        bytes in prop_oneof![mutated(VALID.as_bytes().to_vec()), mutated(without_segments())],
+    ) {
         check(&bytes)?;
     }
 }
