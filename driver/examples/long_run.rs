@@ -20,6 +20,7 @@ use decoder::model::{train, ModelKind, ModelSpec, TrainConfig, TrainedModel};
 use decoder::session::{Session, WindowOptions};
 use driver::daemon::Snapshot;
 use driver::demo::{closed_loop, record_calibration, ClosedLoop};
+use driver::rt::{lock_memory, RtReport};
 use hand_clock::{Clock, SystemClock};
 
 type Error = Box<dyn std::error::Error>;
@@ -81,6 +82,11 @@ fn train_model(dir: &Path) -> Result<(), Error> {
 
 /// Runs the loop for `minutes`; returns the samples and the daemon thread's end state.
 fn run(model: &TrainedModel, minutes: f64) -> Result<(Vec<Sample>, DaemonEnd), Error> {
+    // As handd does before its loop: lock memory (no page fault in a tick); normal scheduling,
+    // since handd's SCHED_FIFO is opt-in (--rt-priority).
+    let mut rt = RtReport::default();
+    lock_memory(&mut rt);
+    eprintln!("memory locked: {} {:?}", rt.memory_locked, rt.warnings);
     let clock = SystemClock::new();
     let ClosedLoop {
         mut world, runner, ..
@@ -146,11 +152,12 @@ fn row(s: &Sample, prev: &Sample) -> String {
     let c = &s.snap.counters;
     let cpu = (s.daemon_cpu_ns - prev.daemon_cpu_ns) as f64 / ((s.t_s - prev.t_s) * 1e9) * 100.0;
     format!(
-        "| {:.0} | {:.2} | {:.3} | {} | {} | {} | {} | {} | {} | {} | {} |",
+        "| {:.0} | {:.2} | {:.3} | {} ({}) | {} | {} | {} | {} | {} | {} | {} |",
         s.t_s,
         mb(s.rss_kb),
         cpu,
         s.snap.state,
+        s.snap.faults,
         c.ticks,
         c.deadline_misses,
         c.samples_lost,
@@ -164,7 +171,7 @@ fn row(s: &Sample, prev: &Sample) -> String {
 /// The per-minute table (and the last sample).
 fn table(samples: &[Sample]) -> String {
     let mut out = String::from(
-        "| t (s) | RSS (MB) | daemon CPU (% of a core, since the last row) | state | ticks | \
+        "| t (s) | RSS (MB) | daemon CPU (% of a core, since the last row) | state (faults) | ticks | \
          deadline misses | samples lost | bad frames | E2E errors | latency p99 (µs) | \
          lateness max (µs) |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
@@ -194,7 +201,7 @@ fn report(samples: &[Sample], end: &DaemonEnd) -> String {
     let lost = end.overflows + c.samples_lost + c.bad_frames + c.e2e_errors;
     let mut out = format!(
         "| figure | measured | goal |\n|---|---|---|\n\
-         | run length | {:.1} s, {} ticks (20 Hz), final state {} | |\n\
+         | run length | {:.1} s, {} ticks (20 Hz), final state {}, faults {} | |\n\
          | frames lost on the bus (daemon's receive queue overflows) | {} | 0 |\n\
          | EMG samples lost / bad frames / E2E errors / e-stops | {} / {} / {} / {} | 0 |\n\
          | deadline misses (5 ms slack) | {} | 0 |\n\
@@ -205,7 +212,7 @@ fn report(samples: &[Sample], end: &DaemonEnd) -> String {
          | compute per tick p50 / p99 / max | {} / {} / {} µs | |\n\
          | tick lateness p50 / p99 / max | {} / {} / {} µs | |\n\
          | nothing lost at all | {} | yes |\n\n",
-        last.t_s, c.ticks, last.snap.state, end.overflows, c.samples_lost, c.bad_frames,
+        last.t_s, c.ticks, last.snap.state, last.snap.faults, end.overflows, c.samples_lost, c.bad_frames,
         c.e2e_errors, c.estops, c.deadline_misses, first.t_s, mb(first.rss_kb), mb(warm.rss_kb),
         mb(last.rss_kb), mb(hi - lo), hi - lo, last.snap.latency.p50_us,
         last.snap.latency.p99_us, last.snap.latency.max_us, last.snap.compute.p50_us,
