@@ -16,10 +16,10 @@ use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use cpu_time::ThreadTime;
-use decoder::model::{train, ModelKind, ModelSpec, TrainConfig, TrainedModel};
-use decoder::session::{Session, WindowOptions};
+use decoder::model::TrainedModel;
+use decoder::session::Session;
 use driver::daemon::Snapshot;
-use driver::demo::{closed_loop, record_calibration, ClosedLoop};
+use driver::demo::{closed_loop, record_calibration, train_on_session, ClosedLoop};
 use driver::rt::{lock_memory, RtReport};
 use hand_clock::{Clock, SystemClock};
 
@@ -55,21 +55,7 @@ fn train_model(dir: &Path) -> Result<(), Error> {
     let session_dir = dir.join("session");
     record_calibration(&session_dir, 1)?;
     let session = Session::open(&session_dir)?;
-    let data = session
-        .windows(&WindowOptions { two_point: false })?
-        .to_dataset(&session.meta.chain)?;
-    let cfg = TrainConfig {
-        max_epochs: 200,
-        seed: 1,
-        ..TrainConfig::default()
-    };
-    let model = train(
-        ModelKind::ResDd,
-        &ModelSpec::default(),
-        &data,
-        &cfg,
-        &mut |_| {},
-    )?;
+    let model = train_on_session(&session, 1, 200, &mut |_| {})?;
     let path = dir.join("model.hsm");
     model.save(&path)?;
     println!(

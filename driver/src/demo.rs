@@ -172,6 +172,24 @@ pub fn record_calibration(dir: &Path, seed: u64) -> Result<usize, DemoError> {
     Ok(run.trials.len())
 }
 
+/// ResDD (default specification) trained on `session`'s labelled windows, seeded.
+pub fn train_on_session(
+    session: &Session,
+    seed: u64,
+    max_epochs: usize,
+    on_epoch: &mut dyn FnMut(EpochReport),
+) -> Result<TrainedModel, DemoError> {
+    let data = session
+        .windows(&WindowOptions { two_point: false })?
+        .to_dataset(&session.meta.chain)?;
+    let cfg = TrainConfig {
+        max_epochs,
+        seed,
+        ..TrainConfig::default()
+    };
+    Ok(train(ModelKind::ResDd, &ModelSpec::default(), &data, &cfg, on_epoch)?)
+}
+
 /// Calibrate, train, track; see the module docs.
 pub fn run_demo(
     opts: &DemoOptions,
@@ -191,21 +209,9 @@ pub fn run_demo(
     on(DemoEvent::Phase(
         "training ResDD on the calibration session",
     ));
-    let data = session
-        .windows(&WindowOptions { two_point: false })?
-        .to_dataset(&session.meta.chain)?;
-    let cfg = TrainConfig {
-        max_epochs: opts.max_epochs,
-        seed: opts.seed,
-        ..TrainConfig::default()
-    };
-    let model = train(
-        ModelKind::ResDd,
-        &ModelSpec::default(),
-        &data,
-        &cfg,
-        &mut |r| on(DemoEvent::Epoch(r)),
-    )?;
+    let model = train_on_session(&session, opts.seed, opts.max_epochs, &mut |r| {
+        on(DemoEvent::Epoch(r))
+    })?;
     let model_path = opts.work_dir.join("model.hsm");
     model.save(&model_path)?;
 

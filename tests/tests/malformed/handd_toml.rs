@@ -6,7 +6,7 @@ use driver::config::{Config, ConfigError};
 use driver::units::FINGER_NAMES;
 use proptest::prelude::*;
 
-use crate::mutate::{arbitrary_bytes, line_count, mentioned_lines, mutated, seeded};
+use crate::mutate::{arbitrary_bytes, mutated, names_lines_of, seeded};
 
 const VALID: &str = r#"interface = "can0"
 model = "/var/lib/handstack/model.hsm"
@@ -60,18 +60,13 @@ fn is_field(field: &str) -> bool {
 
 fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
     let text = String::from_utf8_lossy(bytes);
-    let lines = line_count(bytes);
     match Config::from_toml(&text, Path::new("handd.toml")) {
         Ok(cfg) => {
             let again = Config::from_toml(&cfg.to_toml(), Path::new("again.toml"));
             prop_assert_eq!(again.ok(), Some(cfg));
         }
         Err(ConfigError::Parse { message, .. }) => {
-            let named = mentioned_lines(&message);
-            prop_assert!(
-                !named.is_empty() && named.iter().all(|l| (1..=lines).contains(l)),
-                "TOML error without a line of the {lines}: {message}"
-            );
+            prop_assert!(names_lines_of(&message, bytes), "no line of the file: {message}");
         }
         Err(ConfigError::Invalid { field, .. }) => {
             prop_assert!(is_field(&field), "not a field: {field:?}");

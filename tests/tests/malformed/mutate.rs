@@ -200,6 +200,13 @@ pub fn mentioned_lines(message: &str) -> Vec<usize> {
         .collect()
 }
 
+/// Whether `message` names at least one line, and only lines of `bytes`.
+pub fn names_lines_of(message: &str, bytes: &[u8]) -> bool {
+    let named = mentioned_lines(message);
+    let lines = line_count(bytes);
+    !named.is_empty() && named.iter().all(|l| (1..=lines).contains(l))
+}
+
 /// Number of lines of `bytes` as an editor counts them (at least 1).
 pub fn line_count(bytes: &[u8]) -> usize {
     bytes.iter().filter(|&&b| b == b'\n').count() + 1

@@ -6,7 +6,7 @@ use std::path::Path;
 use decoder::session::{SessionError, SessionMeta};
 use proptest::prelude::*;
 
-use crate::mutate::{arbitrary_bytes, line_count, mentioned_lines, mutated, seeded};
+use crate::mutate::{arbitrary_bytes, mentioned_lines, mutated, names_lines_of, seeded};
 
 const VALID: &str = r#"format_version = 1
 onset_skip_ms = 150.0
@@ -81,18 +81,13 @@ const PLACES: &[&str] = &[
 /// Parses `bytes` (as a reader of the file would see them): a value, or an error naming where.
 fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
     let text = String::from_utf8_lossy(bytes);
-    let lines = line_count(bytes);
     match SessionMeta::parse(&text, Path::new("s/session.toml")) {
         Ok(meta) => {
             let again = SessionMeta::parse(&meta.to_toml(), Path::new("again.toml"));
             prop_assert_eq!(again.ok(), Some(meta));
         }
         Err(SessionError::Toml { message, .. }) => {
-            let named = mentioned_lines(&message);
-            prop_assert!(
-                !named.is_empty() && named.iter().all(|l| (1..=lines).contains(l)),
-                "TOML error without a line of the {lines}: {message}"
-            );
+            prop_assert!(names_lines_of(&message, bytes), "no line of the file: {message}");
         }
         Err(SessionError::Invalid { message, .. }) => {
             prop_assert!(PLACES.iter().any(|p| message.contains(p)), "{message}");
