@@ -68,11 +68,6 @@ fn train_model(dir: &Path) -> Result<(), Error> {
 
 /// Runs the loop for `minutes`; returns the samples and the daemon thread's end state.
 fn run(model: &TrainedModel, minutes: f64) -> Result<(Vec<Sample>, DaemonEnd), Error> {
-    // As handd does before its loop: lock memory (no page fault in a tick); normal scheduling,
-    // since handd's SCHED_FIFO is opt-in (--rt-priority).
-    let mut rt = RtReport::default();
-    lock_memory(&mut rt);
-    eprintln!("memory locked: {} {:?}", rt.memory_locked, rt.warnings);
     let clock = SystemClock::new();
     let ClosedLoop {
         mut world, runner, ..
@@ -220,6 +215,11 @@ fn main() -> Result<(), Error> {
                 return Err(format!("minutes must be > 0, got {minutes}").into());
             }
             let model = TrainedModel::load(model, None)?;
+            // As handd does before its loop: lock memory (no page fault in a tick); normal
+            // scheduling, since handd's SCHED_FIFO is opt-in (--rt-priority).
+            let mut rt = RtReport::default();
+            lock_memory(&mut rt);
+            eprintln!("memory locked: {} {:?}", rt.memory_locked, rt.warnings);
             let (samples, end) = run(&model, minutes)?;
             print!("{}", report(&samples, &end));
             Ok(())

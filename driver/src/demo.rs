@@ -187,7 +187,13 @@ pub fn train_on_session(
         seed,
         ..TrainConfig::default()
     };
-    Ok(train(ModelKind::ResDd, &ModelSpec::default(), &data, &cfg, on_epoch)?)
+    Ok(train(
+        ModelKind::ResDd,
+        &ModelSpec::default(),
+        &data,
+        &cfg,
+        on_epoch,
+    )?)
 }
 
 /// Calibrate, train, track; see the module docs.

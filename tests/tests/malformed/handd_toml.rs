@@ -66,7 +66,10 @@ fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
             prop_assert_eq!(again.ok(), Some(cfg));
         }
         Err(ConfigError::Parse { message, .. }) => {
-            prop_assert!(names_lines_of(&message, bytes), "no line of the file: {message}");
+            prop_assert!(
+                names_lines_of(&message, bytes),
+                "no line of the file: {message}"
+            );
         }
         Err(ConfigError::Invalid { field, .. }) => {
             prop_assert!(is_field(&field), "not a field: {field:?}");

@@ -87,7 +87,10 @@ fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
             prop_assert_eq!(again.ok(), Some(meta));
         }
         Err(SessionError::Toml { message, .. }) => {
-            prop_assert!(names_lines_of(&message, bytes), "no line of the file: {message}");
+            prop_assert!(
+                names_lines_of(&message, bytes),
+                "no line of the file: {message}"
+            );
         }
         Err(SessionError::Invalid { message, .. }) => {
             prop_assert!(PLACES.iter().any(|p| message.contains(p)), "{message}");
