@@ -4,15 +4,20 @@
 //! frames `#R` with an optional DLC digit (`123#R4`). CAN FD lines (`123##1...`) and classic
 //! frames with a DLC beyond 8 (`..._9`) are refused with a clear error: the hand bus is
 //! classic CAN. Every malformed line is reported with its line number and what is wrong;
-//! parsing never panics.
+//! parsing never panics. A line is read into a buffer of at most [`MAX_LINE_BYTES`]: a file
+//! without newlines is refused at its first line, never buffered whole.
 
 use std::fmt::Write as _;
-use std::io::{self, BufRead, Write};
+use std::io::{self, BufRead, Read, Write};
 use std::path::Path;
 
 use embedded_can::{ExtendedId, StandardId};
 
 use crate::frame::CanFrame;
+
+/// Longest line accepted, bytes (without its newline). The longest valid line, a 20-digit
+/// timestamp, a 15-character interface and an extended frame of 8 bytes, is under 70 bytes.
+pub const MAX_LINE_BYTES: usize = 256;
 
 /// One log line: receive time, interface and frame.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -69,6 +74,12 @@ pub enum LineError {
     /// A remote frame with a bad DLC digit.
     #[error("bad remote frame DLC {0:?}: expected one digit 0..8 after 'R'")]
     BadRemoteDlc(String),
+    /// The line is longer than [`MAX_LINE_BYTES`].
+    #[error("line longer than {MAX_LINE_BYTES} bytes: not a candump line")]
+    LineTooLong,
+    /// The line is not UTF-8 text.
+    #[error("byte {0} is not UTF-8 text")]
+    NotUtf8(usize),
 }
 
 /// Reading a log failed.
@@ -197,7 +208,7 @@ pub fn format_line(entry: &LogEntry) -> String {
 pub struct LogReader<R> {
     input: R,
     line: usize,
-    buf: String,
+    buf: Vec<u8>,
 }
 
 impl<R: BufRead> LogReader<R> {
@@ -206,9 +217,56 @@ impl<R: BufRead> LogReader<R> {
         Self {
             input,
             line: 0,
-            buf: String::new(),
+            buf: Vec::with_capacity(MAX_LINE_BYTES + 1),
         }
     }
+
+    /// Reads the next line into `buf`, keeping at most `MAX_LINE_BYTES + 1` bytes of it (the
+    /// rest of a longer line is read and dropped). `Ok(false)` at the end of the input.
+    fn read_bounded_line(&mut self) -> io::Result<bool> {
+        self.buf.clear();
+        let limit = (MAX_LINE_BYTES + 1) as u64;
+        let n = (&mut self.input)
+            .take(limit)
+            .read_until(b'\n', &mut self.buf)?;
+        if n == 0 {
+            return Ok(false);
+        }
+        if self.buf.last() != Some(&b'\n') && self.buf.len() > MAX_LINE_BYTES {
+            skip_to_newline(&mut self.input)?;
+        }
+        Ok(true)
+    }
+}
+
+/// Consumes input up to and including the next newline, without buffering it.
+fn skip_to_newline(input: &mut impl BufRead) -> io::Result<()> {
+    loop {
+        let chunk = input.fill_buf()?;
+        if chunk.is_empty() {
+            return Ok(());
+        }
+        match chunk.iter().position(|&b| b == b'\n') {
+            Some(i) => {
+                input.consume(i + 1);
+                return Ok(());
+            }
+            None => {
+                let n = chunk.len();
+                input.consume(n);
+            }
+        }
+    }
+}
+
+/// The text of one raw line without its line ending, or what is wrong with it.
+fn line_text(raw: &[u8]) -> Result<&str, LineError> {
+    let raw = raw.strip_suffix(b"\n").unwrap_or(raw);
+    let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
+    if raw.len() > MAX_LINE_BYTES {
+        return Err(LineError::LineTooLong);
+    }
+    std::str::from_utf8(raw).map_err(|e| LineError::NotUtf8(e.valid_up_to() + 1))
 }
 
 impl<R: BufRead> Iterator for LogReader<R> {
@@ -216,21 +274,22 @@ impl<R: BufRead> Iterator for LogReader<R> {
 
     fn next(&mut self) -> Option<Self::Item> {
         loop {
-            self.buf.clear();
             self.line += 1;
-            match self.input.read_line(&mut self.buf) {
-                Ok(0) => return None,
-                Ok(_) => {}
+            match self.read_bounded_line() {
+                Ok(false) => return None,
+                Ok(true) => {}
                 Err(e) => return Some(Err(CandumpError::Io(e))),
             }
-            let text = self.buf.trim_end_matches(['\n', '\r']);
+            let line = self.line;
+            let at = |error| CandumpError::Line { line, error };
+            let text = match line_text(&self.buf) {
+                Ok(text) => text,
+                Err(e) => return Some(Err(at(e))),
+            };
             if text.trim().is_empty() {
                 continue;
             }
-            return Some(parse_line(text).map_err(|error| CandumpError::Line {
-                line: self.line,
-                error,
-            }));
+            return Some(parse_line(text).map_err(at));
         }
     }
 }
@@ -389,5 +448,56 @@ mod tests {
             "{msg}"
         );
         assert!(msg.starts_with("line 3: CAN FD"), "{msg}");
+    }
+}
+
+#[cfg(test)]
+mod hostile_input {
+    use super::*;
+
+    // Regression: a log without newlines used to be buffered whole (`read_line` has no bound).
+    #[test]
+    fn an_overlong_line_is_refused_with_its_number_and_reading_goes_on() {
+        let long = "(1.000000) vcan0 123#00".to_string() + &" ".repeat(MAX_LINE_BYTES);
+        let text = format!("(1.000000) vcan0 123#00\n{long}\n(2.000000) vcan0 124#01\n");
+        let mut reader = LogReader::new(text.as_bytes());
+        assert!(reader.next().expect("line 1").is_ok());
+        let err = reader.next().expect("line 2").expect_err("too long");
+        assert_eq!(
+            err.to_string(),
+            "line 2: line longer than 256 bytes: not a candump line"
+        );
+        let third = reader
+            .next()
+            .expect("line 3")
+            .expect("the next line is read whole");
+        assert_eq!(third.frame.raw_id(), 0x124);
+        assert!(reader.next().is_none());
+        // The longest line accepted, with and without a final newline.
+        let edge = format!("(1.000000) vcan0 123#00{}", " ".repeat(MAX_LINE_BYTES - 23));
+        assert_eq!(edge.len(), MAX_LINE_BYTES);
+        assert!(parse_log(&edge).is_ok());
+        assert!(parse_log(&format!("{edge}\r\n")).is_ok());
+        assert!(parse_log(&format!("{edge} ")).is_err());
+    }
+
+    // Regression: invalid UTF-8 used to come out as an I/O error without a line number.
+    #[test]
+    fn bytes_that_are_not_utf8_are_refused_with_line_and_byte() {
+        let bytes = b"(1.000000) vcan0 123#00\n(2.0\xff0000) vcan0 123#00\n";
+        let err = LogReader::new(&bytes[..])
+            .collect::<Result<Vec<_>, _>>()
+            .expect_err("line 2 is not text");
+        assert!(
+            matches!(
+                err,
+                CandumpError::Line {
+                    line: 2,
+                    error: LineError::NotUtf8(5)
+                }
+            ),
+            "{err}"
+        );
+        assert_eq!(err.to_string(), "line 2: byte 5 is not UTF-8 text");
     }
 }

@@ -27,3 +27,4 @@ pub mod eval;
 pub mod fsio;
 pub mod model;
 pub mod session;
+pub mod textfile;

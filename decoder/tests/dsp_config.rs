@@ -1,7 +1,9 @@
 //! Validation of the chain configuration: defaults, the 10-channel and 200 Hz set-ups, and a
 //! clear error naming the field and the limit for every bad value.
 
-use decoder::dsp::{ChainConfig, ConfigError, FeatureSignal, FEATURE_NAMES};
+use decoder::dsp::{
+    ChainConfig, ConfigError, FeatureSignal, FEATURE_NAMES, MAX_HARMONICS, MAX_WINDOW_SAMPLES,
+};
 
 fn err(cfg: ChainConfig) -> (ConfigError, String) {
     let e = cfg.validate().expect_err("configuration must be refused");
@@ -271,4 +273,53 @@ fn serde_round_trip_defaults_and_unknown_fields() {
 
     let e = toml::from_str::<ChainConfig>("chanels = 10\n").expect_err("typo refused");
     assert!(e.to_string().contains("chanels"), "{e}");
+}
+
+// Regression: `mains_harmonics = 4294967295` sized a vector of 2^32 notch frequencies before any
+// check (an allocation of 32 GiB), and a window of 1e7 samples sized the chain's ring at
+// 2 × 1e7 samples per channel. Both fields are now bounded before anything is sized by them.
+#[test]
+fn fields_that_size_memory_are_bounded_first() {
+    let (e, msg) = err(ChainConfig {
+        sample_rate_hz: 1e300,
+        band_high_hz: 450.0,
+        mains_harmonics: u32::MAX,
+        ..ChainConfig::default()
+    });
+    assert_eq!(e, ConfigError::Harmonics(u32::MAX));
+    assert!(
+        msg.contains("mains_harmonics = 4294967295: must be at most 20"),
+        "{msg}"
+    );
+    ChainConfig {
+        sample_rate_hz: 10_000.0,
+        mains_harmonics: MAX_HARMONICS,
+        ..ChainConfig::default()
+    }
+    .validate()
+    .expect("the largest count of harmonics below Nyquist");
+
+    let longest = ChainConfig {
+        window_ms: MAX_WINDOW_SAMPLES as f64,
+        ..ChainConfig::default()
+    };
+    assert_eq!(
+        longest.validate().expect("65536 samples").window_len(),
+        65_536
+    );
+    let (e, msg) = err(ChainConfig {
+        window_ms: (MAX_WINDOW_SAMPLES + 1) as f64,
+        ..ChainConfig::default()
+    });
+    assert!(
+        matches!(
+            e,
+            ConfigError::Timing {
+                field: "window_ms",
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    assert!(msg.contains("at most 65536 samples"), "{msg}");
 }

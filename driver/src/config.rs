@@ -6,7 +6,6 @@
 //! file behind.
 
 use std::fmt;
-use std::fs;
 use std::path::{Path, PathBuf};
 
 use decoder::fsio::write_atomic;
@@ -359,7 +358,7 @@ impl Config {
 
     /// Read, parse and validate a config file.
     pub fn load(path: &Path) -> Result<Self, ConfigError> {
-        let text = fs::read_to_string(path).map_err(|source| ConfigError::Io {
+        let text = decoder::textfile::read_text(path).map_err(|source| ConfigError::Io {
             path: path.to_owned(),
             source,
         })?;
@@ -393,6 +392,7 @@ impl fmt::Display for FingerConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::fs;
 
     #[test]
     fn default_config_is_valid_and_round_trips() {

@@ -187,6 +187,11 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         &self.engine
     }
 
+    /// The transport (the long run reads the in-memory bus's overflow count).
+    pub fn transport(&self) -> &T {
+        &self.transport
+    }
+
     /// Mutable access to the engine (to mark it validated, or to inject a fault in tests).
     pub fn engine_mut(&mut self) -> &mut Engine {
         &mut self.engine

@@ -24,12 +24,13 @@ use decoder::session::{check_gates, GateConfig, LabelledWindows, Session, Window
 use hand_clock::{Clock, SystemClock, VirtualClock};
 use hand_dbc::candump::LogWriter;
 use hand_dbc::messages::FingerStatus;
+use hand_dbc::CanFrame;
 use hand_model::emg::AmplifierConfig;
 use hand_model::nodes::AmplifierNodeConfig;
 use hand_model::patient::TrackingConfig;
 use hand_model::record::run_on_mem_bus;
 use hand_model::world::{PatientMode, World, WorldConfig};
-use hand_model::{MemBus, Scenario};
+use hand_model::{MemBus, MemEndpoint, Scenario};
 
 use crate::config::Config;
 use crate::daemon::{Runner, Snapshot};
@@ -201,13 +202,17 @@ pub fn record_calibration(dir: &Path, seed: u64) -> Result<usize, DemoError> {
     Ok(run.trials.len())
 }
 
-/// Trains ResDD on the calibration session with the demo's label and training options.
-fn train_resdd(
+/// ResDD trained on `session`'s calibration with the demo's label and training options, then
+/// verified as `handctl train` verifies it ([`certify`]); the long-run script trains the same way.
+pub fn train_on_session(
     session: &Session,
-    windows: &LabelledWindows,
     opts: &DemoOptions,
-    on: &mut impl FnMut(DemoEvent<'_>),
+    on_epoch: &mut dyn FnMut(EpochReport),
 ) -> Result<TrainedModel, DemoError> {
+    let windows = session.windows(&WindowOptions {
+        mask_others: opts.mask_others,
+        ..WindowOptions::default()
+    })?;
     let data = windows.to_dataset(&session.meta.chain)?;
     let base = if opts.plain {
         TrainConfig::plain()
@@ -219,13 +224,14 @@ fn train_resdd(
         seed: opts.seed,
         ..base
     };
-    Ok(train(
+    let model = train(
         ModelKind::ResDd,
         &ModelSpec::default(),
         &data,
         &cfg,
-        &mut |r| on(DemoEvent::Epoch(r)),
-    )?)
+        on_epoch,
+    )?;
+    certify(model, session, &windows, opts.plain)
 }
 
 /// Calibrate, train, track; see the module docs.
@@ -247,12 +253,7 @@ pub fn run_demo(
     on(DemoEvent::Phase(
         "training ResDD on the calibration session and verifying its effort rays",
     ));
-    let windows = session.windows(&WindowOptions {
-        mask_others: opts.mask_others,
-        ..WindowOptions::default()
-    })?;
-    let model = train_resdd(&session, &windows, opts, &mut on)?;
-    let model = certify(model, &session, &windows, opts.plain)?;
+    let model = train_on_session(&session, opts, &mut |r| on(DemoEvent::Epoch(r)))?;
     let model_path = opts.work_dir.join("model.hsm");
     model.save(&model_path)?;
 
@@ -329,42 +330,47 @@ impl DemoClock for VirtualClock {
 }
 impl DemoClock for SystemClock {}
 
-/// One scored moment: at an index FINGER_STATUS.
-struct TrackSample {
-    /// The sine's target.
-    target: f64,
-    /// The index finger's force / full scale.
-    tracked: f64,
-    /// The decoder's raw label of every finger (before conditioning), from the snapshot.
-    labels: [f64; N_FINGERS],
+/// The tracking phase's closed loop, ready to run: the simulated world (amplifier, the five
+/// finger controllers, the patient following a sine with one finger) and the daemon's loop
+/// with the default configuration, on one in-memory bus that reads `clock`.
+pub struct ClosedLoop<K: Clock> {
+    /// The simulated hand, amplifier and patient.
+    pub world: World<MemEndpoint<CanFrame>>,
+    /// The daemon's loop (validated, so it runs as soon as EMG arrives).
+    pub runner: Runner<MemTransport<K>, K>,
+    /// The bus (for more endpoints).
+    pub bus: MemBus,
+    /// Start of the loop on `clock`, µs.
+    pub start_us: u64,
+    /// What the patient tracks.
+    pub tracking: TrackingConfig,
 }
 
-/// Runs the closed loop; returns a sample at every index FINGER_STATUS.
-fn track<K: DemoClock>(
+/// Builds the [`ClosedLoop`] for `model`; `seed` seeds the patient (and, plus one, the
+/// amplifier's noise).
+pub fn closed_loop<K: Clock + Clone + Send + Sync + 'static>(
     model: &TrainedModel,
-    opts: &DemoOptions,
+    seed: u64,
     clock: K,
-    virtual_time: bool,
-    on: &mut impl FnMut(DemoEvent<'_>),
-) -> Result<(Vec<TrackSample>, Snapshot), DemoError> {
+) -> Result<ClosedLoop<K>, DemoError> {
     let tracking = TrackingConfig {
-        seed: opts.seed,
+        seed,
         ..TrackingConfig::default()
     };
     let patient = hand_model::patient::ClosedLoopUser::try_new(tracking)?;
     let bus = MemBus::with_clock(clock.clone());
     let b = bus.clone();
-    let start = clock.now_us();
-    let mut world = World::try_new(
+    let start_us = clock.now_us();
+    let world = World::try_new(
         WorldConfig {
             amplifier: AmplifierNodeConfig {
                 signal: AmplifierConfig {
-                    seed: opts.seed + 1,
+                    seed: seed + 1,
                     ..AmplifierConfig::default()
                 },
                 ..AmplifierNodeConfig::default()
             },
-            start_us: start,
+            start_us,
             ..WorldConfig::default()
         },
         PatientMode::ClosedLoop(Box::new(patient)),
@@ -383,7 +389,41 @@ fn track<K: DemoClock>(
     );
     engine.validated(clock.now_us());
     let transport = MemTransport::new(bus.endpoint(), clock.clone());
-    let mut runner = Runner::new(engine, transport, clock.clone(), config.tick_ms * 1000);
+    let runner = Runner::new(engine, transport, clock, config.tick_ms * 1000);
+    Ok(ClosedLoop {
+        world,
+        runner,
+        bus,
+        start_us,
+        tracking,
+    })
+}
+
+/// One scored moment: at an index FINGER_STATUS.
+struct TrackSample {
+    /// The sine's target.
+    target: f64,
+    /// The index finger's force / full scale.
+    tracked: f64,
+    /// The decoder's raw label of every finger (before conditioning), from the snapshot.
+    labels: [f64; N_FINGERS],
+}
+
+/// Runs the closed loop; returns a sample at every index FINGER_STATUS.
+fn track<K: DemoClock>(
+    model: &TrainedModel,
+    opts: &DemoOptions,
+    clock: K,
+    virtual_time: bool,
+    on: &mut impl FnMut(DemoEvent<'_>),
+) -> Result<(Vec<TrackSample>, Snapshot), DemoError> {
+    let ClosedLoop {
+        mut world,
+        mut runner,
+        bus,
+        start_us: start,
+        tracking,
+    } = closed_loop(model, opts.seed, clock.clone())?;
     let mut probe = bus.endpoint();
     let end = start + (opts.track_s * 1e6) as u64;
     let mut samples = Vec::new();

@@ -18,6 +18,11 @@ impl<K: Clock> MemTransport<K> {
     pub fn new(endpoint: MemEndpoint<CanFrame>, clock: K) -> Self {
         Self { endpoint, clock }
     }
+
+    /// Frames dropped because the receive queue was full (the bus's lost frames).
+    pub fn overflows(&self) -> u64 {
+        self.endpoint.overflows()
+    }
 }
 
 impl<K: Clock> Transport for MemTransport<K> {

@@ -162,7 +162,7 @@ pub fn parse_request_bytes(line: &[u8]) -> Result<Request, String> {
         .map_err(|e| format!("malformed request: not UTF-8 text ({e})"))?;
     let malformed = |e: serde_json::Error| format!("malformed request: {e}");
     let value: serde_json::Value = serde_json::from_str(line.trim()).map_err(malformed)?;
-    let req: Request = Request::deserialize(&value).map_err(malformed)?;
+    let req: Request = Request::deserialize(&value).map_err(|e| name_the_field(&value, e))?;
     // serde ignores unknown fields beside the tag of a variant without fields: check them all.
     let allowed = req.fields();
     if let Some(extra) = value.as_object().and_then(|o| {
@@ -179,6 +179,33 @@ pub fn parse_request_bytes(line: &[u8]) -> Result<Request, String> {
         ));
     }
     Ok(req)
+}
+
+/// A request that is valid JSON but not a valid command, with the field at fault named: the
+/// tagged enum is read from a parsed value, whose errors carry no position, so the field is
+/// found by reading the command with each field alone (the one that fails for a reason other
+/// than the fields left out is the one at fault).
+fn name_the_field(value: &serde_json::Value, e: serde_json::Error) -> String {
+    let msg = e.to_string();
+    let Some(obj) = value.as_object() else {
+        return format!(
+            "malformed request: at line 1 column 1: a request is one JSON object ({msg})"
+        );
+    };
+    if msg.contains("variant") || msg.contains("`cmd`") || !obj.contains_key("cmd") {
+        return format!("malformed request: field `cmd`: {msg}");
+    }
+    let culprit = obj
+        .iter()
+        .filter(|(k, _)| k.as_str() != "cmd")
+        .find(|(k, v)| {
+            let alone = serde_json::json!({ "cmd": obj["cmd"], k.as_str(): v });
+            Request::deserialize(&alone).is_err_and(|e| !e.to_string().starts_with("missing field"))
+        });
+    match culprit {
+        Some((k, _)) => format!("malformed request: field `{k}`: {msg}"),
+        None => format!("malformed request: {msg}"),
+    }
 }
 
 impl Request {
@@ -252,7 +279,19 @@ mod tests {
         assert!(parse_request(r#"{"cmd":"explode"}"#)
             .unwrap_err()
             .contains("explode"));
-        assert!(parse_request(r#"{"cmd":"tune","finger":"index","kf":"x"}"#).is_err());
+        let e = parse_request(r#"{"cmd":"tune","finger":"index","kf":"x"}"#).unwrap_err();
+        assert!(
+            e.contains("field `kf`") && e.contains("invalid type"),
+            "{e}"
+        );
+        let e = parse_request(r#"{"cmd":"subscribe","every_ms":-5}"#).unwrap_err();
+        assert!(e.contains("field `every_ms`"), "{e}");
+        let e = parse_request(r#"{"cmd":"tune","kf":1}"#).unwrap_err();
+        assert!(e.contains("missing field `finger`"), "{e}");
+        let e = parse_request(r#"{"cmd":"explode"}"#).unwrap_err();
+        assert!(e.contains("field `cmd`"), "{e}");
+        let e = parse_request("[1,2]").unwrap_err();
+        assert!(e.contains("one JSON object"), "{e}");
         assert!(parse_request(&"x".repeat(5000))
             .unwrap_err()
             .contains("longer"));

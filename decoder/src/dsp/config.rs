@@ -14,6 +14,12 @@ pub const MAX_CHANNELS: usize = 256;
 pub const MAX_ORDER: usize = 10;
 /// Accepted notch quality factors.
 pub const Q_RANGE: (f64, f64) = (0.5, 1000.0);
+/// Most mains harmonics accepted besides the fundamental: each is a filter section, so the
+/// field is bounded before anything is sized by it.
+pub const MAX_HARMONICS: u32 = 20;
+/// Longest window accepted, samples: the chain keeps two windows per channel, so this bounds
+/// its memory (about 268 MB at [`MAX_CHANNELS`], 12.6 MB at 12 channels) whatever a file says.
+pub const MAX_WINDOW_SAMPLES: usize = 65_536;
 
 /// Which signal the features are computed on.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
@@ -117,6 +123,9 @@ pub enum ConfigError {
     /// Notch Q outside its range.
     #[error("notch_q = {0}: must be between {lo} and {hi}", lo = Q_RANGE.0, hi = Q_RANGE.1)]
     NotchQ(f64),
+    /// More harmonics than [`MAX_HARMONICS`].
+    #[error("mains_harmonics = {0}: must be at most {MAX_HARMONICS}")]
+    Harmonics(u32),
     /// A notch (fundamental or harmonic) at or above Nyquist.
     #[error(
         "mains_harmonics = {harmonics}: the notch at {freq} Hz is not below the Nyquist frequency, {nyquist} Hz at sample_rate_hz = {fs}"
@@ -174,8 +183,8 @@ fn whole_samples(field: &'static str, ms: f64, fs: f64, min: usize) -> Result<us
         fs,
         why,
     };
-    if !samples.is_finite() || samples > 1e7 {
-        return Err(err("must be finite and at most 1e7 samples"));
+    if !samples.is_finite() || samples > MAX_WINDOW_SAMPLES as f64 {
+        return Err(err("must be finite and at most 65536 samples"));
     }
     let rounded = samples.round();
     if (samples - rounded).abs() > 1e-9 * rounded.max(1.0) {
@@ -246,6 +255,9 @@ impl ChainConfig {
         let q = self.notch_q;
         if !(q.is_finite() && q >= Q_RANGE.0 && q <= Q_RANGE.1) {
             return Err(ConfigError::NotchQ(q));
+        }
+        if self.mains_harmonics > MAX_HARMONICS {
+            return Err(ConfigError::Harmonics(self.mains_harmonics));
         }
         let nyquist = fs / 2.0;
         let n_notches = self.mains_harmonics as usize + 1;

@@ -67,7 +67,8 @@ mod sos;
 pub use batch::{batch_features, batch_filtered, try_batch_features, BatchError, FeatureMatrix};
 pub use chain::{Chain, FLUSH_BELOW};
 pub use config::{
-    ChainConfig, ChainSettings, ConfigError, FeatureSignal, MAX_CHANNELS, MAX_ORDER, Q_RANGE,
+    ChainConfig, ChainSettings, ConfigError, FeatureSignal, MAX_CHANNELS, MAX_HARMONICS, MAX_ORDER,
+    MAX_WINDOW_SAMPLES, Q_RANGE,
 };
 pub use design::{butter_bandpass, dc_highpass, iirnotch};
 pub use faults::{Faults, MAX_ABS_SAMPLE};

@@ -56,12 +56,13 @@ pub fn parse_npy(bytes: &[u8]) -> Result<NpyArray, NpyError> {
         return Err(format_err("Fortran-order arrays are not supported"));
     }
     let shape = parse_shape(dict_value(header, "shape")?)?;
-    let count: usize = shape.iter().product();
     let payload = &bytes[data_start..];
     let (size, convert) = dtype(descr)?;
-    let needed = count
-        .checked_mul(size)
-        .ok_or_else(|| format_err("shape too large"))?;
+    // Checked: a corrupt shape such as (2**40, 2**40) must not overflow the count.
+    let needed = shape
+        .iter()
+        .try_fold(size, |n, &d| n.checked_mul(d))
+        .ok_or_else(|| format_err(format!("shape {shape:?} is too large")))?;
     if payload.len() < needed {
         return Err(format_err(format!(
             "data holds {} bytes, shape {shape:?} of {descr} needs {needed}",
@@ -203,5 +204,19 @@ mod tests {
         let err = parse_npy(&short).expect_err("too short").to_string();
         assert!(err.contains("needs 32"), "{err}");
         assert!(parse_npy(&npy(">f8", "(0,)", &[])).is_err());
+    }
+
+    // Regression: the element count was an unchecked product (a panic in debug builds).
+    #[test]
+    fn a_shape_whose_size_overflows_is_refused() {
+        let huge = npy("<f8", "(4294967296, 4294967296, 2)", &[0u8; 8]);
+        let err = parse_npy(&huge).expect_err("overflowing shape").to_string();
+        assert!(
+            err.contains("shape [4294967296, 4294967296, 2] is too large"),
+            "{err}"
+        );
+        let big = npy("<i2", "(1099511627776, 12)", &[0u8; 24]);
+        let err = parse_npy(&big).expect_err("claims 2**40 rows").to_string();
+        assert!(err.contains("needs 26388279066624"), "{err}");
     }
 }

@@ -41,6 +41,9 @@ use crate::fsio::write_atomic;
 pub const FORMAT_VERSION: u32 = 1;
 /// Name of the metadata file in a session directory.
 pub const META_FILE: &str = "session.toml";
+/// Latest time a session may name, µs (292 000 years): TOML integers are signed 64-bit, so
+/// a later time (e.g. from a huge `end_sample`) could not be written back.
+pub const MAX_TIME_US: u64 = i64::MAX as u64;
 
 /// How the raw signal is stored.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -219,10 +222,24 @@ impl SessionMeta {
                 ),
             ));
         }
+        if let Some(fs) = self.recording.full_scale {
+            if !(fs.is_finite() && fs > 0.0) {
+                return Err(SessionError::invalid(
+                    path,
+                    format!("recording.full_scale {fs} must be finite and > 0"),
+                ));
+            }
+        }
         if self.trials.is_empty() {
             return Err(SessionError::invalid(path, "the session has no [[trial]]"));
         }
         for (i, s) in self.segments.iter().enumerate() {
+            if s.end_us > MAX_TIME_US {
+                return Err(SessionError::invalid(
+                    path,
+                    format!("segment {i}: end_us {} is beyond {MAX_TIME_US}", s.end_us),
+                ));
+            }
             if s.end_us <= s.start_us {
                 return Err(SessionError::invalid(
                     path,
@@ -241,32 +258,34 @@ impl SessionMeta {
                     format!("trial id {} appears twice", t.id),
                 ));
             }
-            if t.end_us <= t.start_us {
-                return Err(SessionError::invalid(
-                    path,
-                    format!(
-                        "{t}: end {} µs is not after start {} µs",
-                        t.end_us, t.start_us
-                    ),
-                ));
-            }
-            if let Some(f) = t.finger {
-                if f >= N_FINGERS {
-                    return Err(SessionError::invalid(
-                        path,
-                        format!("{t}: finger {f} is not 0..4"),
-                    ));
-                }
-            }
-            if !self.segments.is_empty() && self.segment_of(t).is_none() {
-                return Err(SessionError::invalid(
-                    path,
-                    format!(
-                        "{t} ({}..{} µs) does not lie inside one [[segment]]",
-                        t.start_us, t.end_us
-                    ),
-                ));
-            }
+            self.check_trial(t)
+                .map_err(|m| SessionError::invalid(path, m))?;
+        }
+        Ok(())
+    }
+
+    /// What is wrong with one trial's times and finger, if anything.
+    fn check_trial(&self, t: &Trial) -> Result<(), String> {
+        if t.end_us > MAX_TIME_US {
+            return Err(format!(
+                "{t}: end {} µs is beyond {MAX_TIME_US} µs",
+                t.end_us
+            ));
+        }
+        if t.end_us <= t.start_us {
+            return Err(format!(
+                "{t}: end {} µs is not after start {} µs",
+                t.end_us, t.start_us
+            ));
+        }
+        if let Some(f) = t.finger.filter(|&f| f >= N_FINGERS) {
+            return Err(format!("{t}: finger {f} is not 0..4"));
+        }
+        if !self.segments.is_empty() && self.segment_of(t).is_none() {
+            return Err(format!(
+                "{t} ({}..{} µs) does not lie inside one [[segment]]",
+                t.start_us, t.end_us
+            ));
         }
         Ok(())
     }
@@ -312,7 +331,7 @@ impl SessionMeta {
     /// Reads `dir/session.toml`.
     pub fn read(dir: &Path) -> Result<Self, SessionError> {
         let path = dir.join(META_FILE);
-        let text = std::fs::read_to_string(&path).map_err(|e| SessionError::io(&path, e))?;
+        let text = crate::textfile::read_text(&path).map_err(|e| SessionError::io(&path, e))?;
         Self::parse(&text, &path)
     }
 

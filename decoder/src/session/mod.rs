@@ -32,7 +32,9 @@ pub use columns::{SampleTable, SplitColumns};
 pub use error::SessionError;
 pub use gates::{check_gates, noisy_against_others, GateConfig, GateIssue, GateKind, GateReport};
 pub use import::{import_3dc, load_3dc, parse_session_spec, SessionSpec, Split};
-pub use meta::{RecordingFormat, RecordingSpec, Segment, SessionMeta, FORMAT_VERSION, META_FILE};
+pub use meta::{
+    RecordingFormat, RecordingSpec, Segment, SessionMeta, FORMAT_VERSION, MAX_TIME_US, META_FILE,
+};
 pub use npy::{npy_f64_bytes, write_npy_f64};
 pub use recording::Recording;
 pub use reference::{Reference, ReferenceSpec, REFERENCE_FILE};
