@@ -75,16 +75,14 @@ impl Epochs {
     }
 
     /// The mode to send finger `f` when the engine wants `wanted`: a SAFE_STOP in place of
-    /// ACTIVE or HOLD until the finger got one in this epoch (DISABLED passes as it is).
+    /// anything else until the finger got one in this epoch. DISABLED too: a controller that
+    /// handd cannot hear may still hear handd, and it must leave its old epoch.
     pub(super) fn mode(&mut self, f: usize, wanted: FingerMode) -> FingerMode {
-        let mode = match wanted {
-            FingerMode::Active | FingerMode::Hold if !self.opened[f] => FingerMode::SafeStop,
-            m => m,
-        };
-        if mode == FingerMode::SafeStop {
-            self.opened[f] = true;
+        if self.opened[f] {
+            return wanted;
         }
-        mode
+        self.opened[f] = true;
+        FingerMode::SafeStop
     }
 
     /// Finger `f` reported its state: true when it newly says it braked by itself, which
@@ -112,8 +110,8 @@ mod tests {
         e.next();
         assert_eq!(e.current(), 0, "wraps");
         assert_eq!(e.begun(), 2);
-        assert_eq!(e.mode(1, Disabled), Disabled, "DISABLED does not open");
-        assert_eq!(e.mode(1, Hold), SafeStop);
+        assert_eq!(e.mode(1, Disabled), SafeStop, "DISABLED opens with a stop too");
+        assert_eq!(e.mode(1, Disabled), Disabled);
         assert_eq!(e.mode(1, Hold), Hold);
         assert_eq!(e.mode(2, SafeStop), SafeStop);
         assert_eq!(e.mode(2, Active), Active, "opened by the stop the engine wanted");

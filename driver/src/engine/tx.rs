@@ -76,7 +76,7 @@ impl Engine {
     }
 
     /// Conditions the labels into setpoints (or stops the fingers) and builds their frames, in
-    /// the current epoch: a finger not yet sent a SAFE_STOP in it gets one instead of ACTIVE.
+    /// the current epoch: a finger not yet sent a SAFE_STOP in it gets one first.
     pub(super) fn build_setpoints(&mut self, running: bool) {
         let dt_s = self.settings.tick_us as f64 * 1e-6;
         let epoch = self.epochs.current();

@@ -6,6 +6,8 @@
 //! Times are kernel receive timestamps of a monitor socket; handsim's scenario time 0 is the
 //! receive time of its first EMG sample (counter 0), so fault onsets are placed on the bus.
 
+mod epoch;
+
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
