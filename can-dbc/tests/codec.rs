@@ -76,14 +76,23 @@ fn decode_refuses_bad_frames() {
             ..
         })
     ));
+    // A setpoint of the 6-byte layout before the epoch is refused, not misread.
+    assert!(matches!(
+        decode(0x200, &[0; 6]),
+        Err(CodecError::WrongLength {
+            expected: 8,
+            got: 6,
+            ..
+        })
+    ));
     // Mode 4 is not in the FingerMode value table.
     assert!(matches!(
-        decode(0x200, &[0, 0x40, 0, 0, 0, 0]),
+        decode(0x200, &[0, 0x40, 0, 0, 0, 0, 0, 0]),
         Err(CodecError::UnknownValue { signal: "Mode", .. })
     ));
     // Force raw 0x7FFF exceeds the DBC max of 50 N.
     assert!(matches!(
-        decode(0x200, &[0, 0, 0xFF, 0x7F, 0, 0]),
+        decode(0x200, &[0, 0, 0xFF, 0x7F, 0, 0, 0, 0]),
         Err(CodecError::RawOutOfRange {
             signal: "Force",
             ..

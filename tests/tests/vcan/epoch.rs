@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 use hand_dbc::messages::{FingerMode, FingerSetpoint, FingerState, FingerStatus};
 use hand_model::dbc::seal;
 use handstack_tests::vcan::monitor::{now_us, writer, Seen};
-use socketcan::{CanSocket, EmbeddedFrame, Socket, SocketOptions};
+use socketcan::{CanSocket, EmbeddedFrame, Frame, Socket};
 
 use super::{wait_scenario_start, Rig, DRILL_SILENCE_MS, ONSET_US, RUN_S};
 
