@@ -40,7 +40,12 @@ fn inject(r: &mut Rig, epoch: u16, velocity: f64) {
 }
 
 fn angle(r: &Rig) -> f64 {
-    r.world.fingers().nth(FINGER).expect("finger").physics().angle_rad
+    r.world
+        .fingers()
+        .nth(FINGER)
+        .expect("finger")
+        .physics()
+        .angle_rad
 }
 
 fn ignored(r: &Rig) -> u64 {
@@ -56,7 +61,10 @@ fn ignored(r: &Rig) -> u64 {
 /// counted; the same frame in the current epoch moves it (the control).
 fn stale_is_ignored_and_current_moves(r: &mut Rig, old: u16) {
     let current = r.runner.engine().epoch();
-    assert_ne!(current, old, "handd came back in the epoch of before the bus-off");
+    assert_ne!(
+        current, old,
+        "handd came back in the epoch of before the bus-off"
+    );
     // Just after a tick: the counter of handd's last frame is the controller's last one.
     let t = r.clock_now().div_ceil(TICK) * TICK + 1_000;
     r.run_until(t);
@@ -65,7 +73,11 @@ fn stale_is_ignored_and_current_moves(r: &mut Rig, old: u16) {
     inject(r, old, v);
     r.run_until(t + 40_000);
     assert_eq!(angle(r), p0, "a stale ACTIVE setpoint moved the finger");
-    assert_eq!(ignored(r), n0 + 1, "the controller counts the stale frame it ignored");
+    assert_eq!(
+        ignored(r),
+        n0 + 1,
+        "the controller counts the stale frame it ignored"
+    );
     // handd's next frame repeats the injected counter (rejected by E2E); the one after is
     // in sequence again: inject the control after it.
     r.run_until(t + 2 * TICK);
@@ -73,7 +85,10 @@ fn stale_is_ignored_and_current_moves(r: &mut Rig, old: u16) {
     r.run_until(t + 2 * TICK + 40_000);
     let moved = (angle(r) - p0).abs();
     println!("stale frame ignored; the control in epoch {current:#06x} moved {moved:.3} rad");
-    assert!(moved > 0.02, "the control moved the finger only {moved} rad");
+    assert!(
+        moved > 0.02,
+        "the control moved the finger only {moved} rad"
+    );
 }
 
 #[test]
@@ -82,7 +97,11 @@ fn a_stale_setpoint_after_a_short_bus_off_does_not_move_the_finger() {
     r.run_until(ONSET);
     assert_eq!(r.runner.engine().state(), DaemonState::Running);
     let old = r.runner.engine().epoch();
-    assert_eq!(last_setpoint(&r, FINGER).epoch(), old, "setpoints carry the epoch");
+    assert_eq!(
+        last_setpoint(&r, FINGER).epoch(),
+        old,
+        "setpoints carry the epoch"
+    );
     // 60 ms off: the controllers do not brake by themselves (150 ms), so they are still bound
     // to the old epoch when the bus comes back; the new epoch's safe stops rebind them.
     r.bus.set_bus_off(true);
@@ -132,10 +151,7 @@ fn after_a_stall_that_brakes_the_controllers_handd_reopens_them_in_a_new_epoch()
         r.clock.set_us(now);
         r.world.step(now);
     }
-    assert!(r
-        .world
-        .fingers()
-        .all(|f| f.state() == FingerState::Braked));
+    assert!(r.world.fingers().all(|f| f.state() == FingerState::Braked));
     // Samples were lost in the stall: SAFE until the signal is good for 500 ms again.
     r.run_until(ONSET + 1_500_000);
     assert_eq!(r.runner.engine().state(), DaemonState::Running);
@@ -144,7 +160,12 @@ fn after_a_stall_that_brakes_the_controllers_handd_reopens_them_in_a_new_epoch()
         "the controllers' self-brake reports start a new epoch"
     );
     for f in r.world.fingers() {
-        assert_eq!(f.state(), FingerState::Active, "finger {} again", f.finger());
+        assert_eq!(
+            f.state(),
+            FingerState::Active,
+            "finger {} again",
+            f.finger()
+        );
         assert_eq!(f.epoch_gate().bound(), Some(r.runner.engine().epoch()));
     }
 }

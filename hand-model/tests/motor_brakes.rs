@@ -230,7 +230,10 @@ fn resumes_only_in_a_new_epoch_after_a_timeout_and_obeys_estop_release() {
                 & (1 << 6)
                 != 0
         });
-    assert!(stale_flagged, "ignored stale-epoch setpoints are reported (fault bit 6)");
+    assert!(
+        stale_flagged,
+        "ignored stale-epoch setpoints are reported (fault bit 6)"
+    );
     assert_eq!(mc.epoch_gate().bound(), Some(1), "bound to the new epoch");
     assert_eq!(
         state_at(1_150_000),

@@ -103,18 +103,30 @@ mod tests {
     fn each_epoch_opens_every_finger_with_a_safe_stop_first() {
         let mut e = Epochs::new(65535);
         for f in 0..N_FINGERS {
-            assert_eq!(e.mode(f, Active), SafeStop, "finger {f}: first frame of the epoch");
+            assert_eq!(
+                e.mode(f, Active),
+                SafeStop,
+                "finger {f}: first frame of the epoch"
+            );
             assert_eq!(e.mode(f, Active), Active);
             assert_eq!(e.mode(f, Hold), Hold);
         }
         e.next();
         assert_eq!(e.current(), 0, "wraps");
         assert_eq!(e.begun(), 2);
-        assert_eq!(e.mode(1, Disabled), SafeStop, "DISABLED opens with a stop too");
+        assert_eq!(
+            e.mode(1, Disabled),
+            SafeStop,
+            "DISABLED opens with a stop too"
+        );
         assert_eq!(e.mode(1, Disabled), Disabled);
         assert_eq!(e.mode(1, Hold), Hold);
         assert_eq!(e.mode(2, SafeStop), SafeStop);
-        assert_eq!(e.mode(2, Active), Active, "opened by the stop the engine wanted");
+        assert_eq!(
+            e.mode(2, Active),
+            Active,
+            "opened by the stop the engine wanted"
+        );
     }
 
     #[test]

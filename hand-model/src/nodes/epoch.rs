@@ -110,7 +110,11 @@ mod tests {
     fn a_new_epoch_retires_the_old_one_for_good() {
         let mut g = EpochGate::new();
         g.admit(SafeStop, 1);
-        assert_eq!(g.admit(Active, 2), Verdict::Ignore, "ACTIVE cannot switch epoch");
+        assert_eq!(
+            g.admit(Active, 2),
+            Verdict::Ignore,
+            "ACTIVE cannot switch epoch"
+        );
         assert_eq!(g.bound(), Some(1));
         assert_eq!(g.admit(SafeStop, 2), Verdict::Follow);
         assert_eq!((g.bound(), g.retired()), (Some(2), Some(1)));
@@ -127,7 +131,11 @@ mod tests {
         g.braked_by_itself();
         assert_eq!((g.bound(), g.retired()), (None, Some(65535)));
         assert_eq!(g.admit(Active, 65535), Verdict::Ignore);
-        assert_eq!(g.admit(SafeStop, 65535), Verdict::Ignore, "its own epoch is retired");
+        assert_eq!(
+            g.admit(SafeStop, 65535),
+            Verdict::Ignore,
+            "its own epoch is retired"
+        );
         // handd's next epoch after 65535 wraps to 0: equality only, so it is simply new.
         assert_eq!(g.admit(Active, 0), Verdict::Ignore);
         assert_eq!(g.admit(SafeStop, 0), Verdict::Follow);

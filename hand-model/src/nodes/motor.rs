@@ -179,7 +179,9 @@ impl FingerNode {
             let status = self.checker.check_frame(Some(frame));
             let decoded = messages::FingerSetpoint::decode(id, frame.data());
             match (status, decoded) {
-                (E2eStatus::Ok, Ok(sp)) if self.gate.admit(sp.mode(), sp.epoch()) == Verdict::Ignore => {
+                (E2eStatus::Ok, Ok(sp))
+                    if self.gate.admit(sp.mode(), sp.epoch()) == Verdict::Ignore =>
+                {
                     self.stale_since_status = true;
                 }
                 (E2eStatus::Ok, Ok(sp)) => {
@@ -213,6 +215,22 @@ impl FingerNode {
         }
     }
 
+    /// FINGER_STATUS's fault bits now; the ones about setpoints since the previous status
+    /// are cleared.
+    fn take_status_faults(&mut self) -> u8 {
+        let bits = [
+            (self.timed_out, FAULT_SETPOINT_TIMEOUT),
+            (self.e2e_errors_since_status, FAULT_SETPOINT_E2E),
+            (self.phys.at_limit, FAULT_JOINT_LIMIT),
+            (self.stale_since_status, FAULT_STALE_EPOCH),
+        ];
+        self.e2e_errors_since_status = false;
+        self.stale_since_status = false;
+        bits.iter()
+            .filter(|(on, _)| *on)
+            .fold(0, |acc, (_, b)| acc | b)
+    }
+
     fn send_status<B: Bus>(&mut self, t: u64, bus: &mut B) {
         self.status_frames += 1;
         let mut silent = false;
@@ -229,21 +247,7 @@ impl FingerNode {
                 _ => {}
             }
         }
-        let mut faults = 0u8;
-        if self.timed_out {
-            faults |= FAULT_SETPOINT_TIMEOUT;
-        }
-        if self.e2e_errors_since_status {
-            faults |= FAULT_SETPOINT_E2E;
-        }
-        if self.phys.at_limit {
-            faults |= FAULT_JOINT_LIMIT;
-        }
-        if self.stale_since_status {
-            faults |= FAULT_STALE_EPOCH;
-        }
-        self.e2e_errors_since_status = false;
-        self.stale_since_status = false;
+        let faults = self.take_status_faults();
         let counter = self.status_counter;
         self.status_counter = (counter + 1) & 0x0F;
         if silent {

@@ -52,8 +52,8 @@ fn next_handd_setpoint(reader: &CanSocket) -> FingerSetpoint {
 /// c + 1 and the right CRC: E2E accepts it. Returns when it was written.
 fn inject_after(reader: &CanSocket, w: &CanSocket, epoch: u16, velocity: f64) -> u64 {
     let handd = next_handd_setpoint(reader);
-    let sp = FingerSetpoint::new(FINGER, FingerMode::Active, 20.0, velocity, epoch)
-        .expect("in range");
+    let sp =
+        FingerSetpoint::new(FINGER, FingerMode::Active, 20.0, velocity, epoch).expect("in range");
     let mut frame = sp.to_frame();
     seal(
         &mut frame,
@@ -93,15 +93,20 @@ fn epoch_before(seen: &[Seen], t: u64) -> u16 {
         .expect("handd sent setpoints before the bus-off")
 }
 
-#[test]
-fn stale_active_setpoint_of_the_old_epoch_after_bus_off_recovery_does_not_move_the_finger() {
-    let rig = Rig::start("epoch", DRILL_SILENCE_MS);
-    let mut sim = rig.sim("sine", RUN_S, &[]);
-    let w = writer(&rig.env.iface);
-    let reader = CanSocket::open(&rig.env.iface).expect("a reader socket");
-    reader
-        .set_read_timeout(Duration::from_millis(100))
-        .expect("read timeout");
+/// What the test did and when (µs on the kernel's time base).
+struct Injected {
+    onset: u64,
+    old: u16,
+    current: u16,
+    here: f64,
+    velocity: f64,
+    stale_from: u64,
+    control_at: u64,
+}
+
+/// Bus-off at the scenario's onset; 300 ms later (handd recovered in a new epoch), the stale
+/// frames, then the control in the current epoch.
+fn bus_off_then_inject(rig: &Rig, reader: &CanSocket, w: &CanSocket) -> Injected {
     let start = wait_scenario_start(&rig.monitor);
     while now_us() < start + ONSET_US {
         std::thread::sleep(Duration::from_millis(1));
@@ -124,29 +129,63 @@ fn stale_active_setpoint_of_the_old_epoch_after_bus_off_recovery_does_not_move_t
     reader.set_nonblocking(true).expect("nonblocking");
     while reader.read_frame().is_ok() {}
     reader.set_nonblocking(false).expect("blocking");
-    let stale_from = inject_after(&reader, &w, old, velocity);
+    let stale_from = inject_after(reader, w, old, velocity);
     for _ in 1..STALE_INJECTIONS {
-        next_handd_setpoint(&reader);
-        inject_after(&reader, &w, old, velocity);
+        next_handd_setpoint(reader);
+        inject_after(reader, w, old, velocity);
     }
-    next_handd_setpoint(&reader);
-    let current = next_handd_setpoint(&reader).epoch();
-    let control_at = inject_after(&reader, &w, current, velocity);
+    next_handd_setpoint(reader);
+    let current = next_handd_setpoint(reader).epoch();
+    let control_at = inject_after(reader, w, current, velocity);
+    Injected {
+        onset,
+        old,
+        current,
+        here,
+        velocity,
+        stale_from,
+        control_at,
+    }
+}
+
+#[test]
+fn stale_active_setpoint_of_the_old_epoch_after_bus_off_recovery_does_not_move_the_finger() {
+    let rig = Rig::start("epoch", DRILL_SILENCE_MS);
+    let mut sim = rig.sim("sine", RUN_S, &[]);
+    let w = writer(&rig.env.iface);
+    let reader = CanSocket::open(&rig.env.iface).expect("a reader socket");
+    reader
+        .set_read_timeout(Duration::from_millis(100))
+        .expect("read timeout");
+    let i = bus_off_then_inject(&rig, &reader, &w);
     std::thread::sleep(Duration::from_millis(200));
     sim.wait_success(Duration::from_secs(60));
     let seen = rig.monitor.finish();
     drop(rig.handd);
+    check_stale_ignored(&seen, &i);
+    check_control_moved(&seen, &i);
+}
 
-    assert_ne!(current, old, "handd recovered in the epoch of before the bus-off");
-    let during = statuses(&seen, stale_from, control_at);
-    assert!(during.len() >= 10, "only {} statuses while the stale frames came", during.len());
-    let (lo, hi) = during
-        .iter()
-        .fold((f64::MAX, f64::MIN), |(lo, hi), s| (lo.min(s.1), hi.max(s.1)));
+fn check_stale_ignored(seen: &[Seen], i: &Injected) {
+    assert_ne!(
+        i.current, i.old,
+        "handd recovered in the epoch of before the bus-off"
+    );
+    let during = statuses(seen, i.stale_from, i.control_at);
+    assert!(
+        during.len() >= 10,
+        "only {} statuses while the stale frames came",
+        during.len()
+    );
+    let (lo, hi) = during.iter().fold((f64::MAX, f64::MIN), |(lo, hi), s| {
+        (lo.min(s.1), hi.max(s.1))
+    });
     println!(
-        "epoch: old {old:#06x}, after recovery {current:#06x}; {STALE_INJECTIONS} stale ACTIVE \
-         setpoints ({velocity} rad/s): finger {FINGER} within [{lo:.3}, {hi:.3}] rad over {} \
-         statuses",
+        "epoch: old {:#06x}, after recovery {:#06x}; {STALE_INJECTIONS} stale ACTIVE setpoints \
+         ({} rad/s): finger {FINGER} within [{lo:.3}, {hi:.3}] rad over {} statuses",
+        i.old,
+        i.current,
+        i.velocity,
         during.len()
     );
     assert!(
@@ -162,17 +201,23 @@ fn stale_active_setpoint_of_the_old_epoch_after_bus_off_recovery_does_not_move_t
         "the controller never reported a setpoint ignored by the epoch rule (did the \
          injected frames reach it past E2E?)"
     );
-    // The control: the same frame in the current epoch moves the finger.
-    let after = statuses(&seen, control_at, control_at + 150_000);
+}
+
+/// The control: the same frame in the current epoch moves the finger.
+fn check_control_moved(seen: &[Seen], i: &Injected) {
+    let before = statuses(seen, i.stale_from, i.control_at)
+        .last()
+        .map_or(i.here, |s| s.1);
+    let after = statuses(seen, i.control_at, i.control_at + 150_000);
     let moved = after
         .iter()
-        .map(|s| (s.1 - during.last().map_or(here, |d| d.1)).abs())
+        .map(|s| (s.1 - before).abs())
         .fold(0.0, f64::max);
     println!(
-        "epoch: the control (same frame, current epoch) moved the finger {moved:.3} rad \
-         ({} statuses after it; injection {} ms after the bus-off)",
+        "epoch: the control (same frame, current epoch) moved the finger {moved:.3} rad ({} \
+         statuses after it; injected {} ms after the bus-off)",
         after.len(),
-        (control_at - onset) / 1000
+        (i.control_at - i.onset) / 1000
     );
     assert!(
         moved >= MOVED_RAD,
