@@ -83,12 +83,12 @@ fn statuses(seen: &[Seen], from: u64, to: u64) -> Vec<(u64, f64, FingerState, u8
 fn epoch_before(seen: &[Seen], t: u64) -> u16 {
     seen.iter()
         .filter(|s| s.time_us < t)
-        .filter_map(|s| {
+        .rev()
+        .find_map(|s| {
             let f = s.frame.as_ref()?;
             (f.raw_id() == FingerSetpoint::IDS[FINGER]).then_some(())?;
             FingerSetpoint::decode(f.raw_id(), f.data()).ok()
         })
-        .last()
         .map(|sp| sp.epoch())
         .expect("handd sent setpoints before the bus-off")
 }
