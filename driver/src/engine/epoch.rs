@@ -6,7 +6,7 @@
 //! SAFE, on every bus recovery (the daemon calls [`super::Engine::new_epoch`] after a reopen)
 //! and when a finger controller reports that it braked by itself (FINGER_STATUS BRAKED with
 //! the setpoint-timeout bit, on the report's rising edge). In each epoch a finger gets a
-//! SAFE_STOP before any ACTIVE or HOLD setpoint: the controller opens an epoch only on a
+//! SAFE_STOP before anything else (DISABLED included): the controller opens an epoch only on a
 //! SAFE_STOP, and ignores every setpoint of another epoch, so frames of an older epoch still
 //! queued in the kernel or in a CAN controller's mailboxes cannot move the finger once the
 //! new epoch's SAFE_STOP has reached it.
