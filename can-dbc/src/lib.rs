@@ -24,13 +24,13 @@
 //! use hand_dbc::messages::{self, FingerMode, FingerSetpoint, Message};
 //!
 //! // Sender: a checked setpoint for finger 1 (index), protected with counter and CRC.
-//! let sp = FingerSetpoint::new(1, FingerMode::Active, 4.5, -0.25)?;
+//! let sp = FingerSetpoint::new(1, FingerMode::Active, 4.5, -0.25, 0)?;
 //! let mut protector = E2eProtector::new(sp.e2e());
 //! let frame = protector.protect_message(&sp)?;
 //! assert_eq!(frame.raw_id(), 0x201);
 //!
 //! // Out-of-range values are refused, never wrapped or saturated.
-//! assert!(FingerSetpoint::new(1, FingerMode::Active, 80.0, 0.0).is_err());
+//! assert!(FingerSetpoint::new(1, FingerMode::Active, 80.0, 0.0, 0).is_err());
 //!
 //! // Receiver: check E2E, then decode by id.
 //! let mut checker = E2eChecker::try_new(FingerSetpoint::E2E[1], 1)?;

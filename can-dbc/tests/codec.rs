@@ -9,8 +9,11 @@ use hand_dbc::CanFrame;
 
 #[test]
 fn setpoint_round_trips_through_bytes_and_frames() {
-    let sp = FingerSetpoint::new(2, FingerMode::Active, 12.34, -1.5).expect("in range");
+    let sp = FingerSetpoint::new(2, FingerMode::Active, 12.34, -1.5, 0xBEEF).expect("in range");
     assert_eq!(sp.id(), 0x202);
+    assert_eq!(sp.epoch(), 0xBEEF);
+    // The epoch is the last two bytes, little-endian (hand.dbc: Epoch 48|16@1+).
+    assert_eq!(&sp.encode()[6..], &[0xEF, 0xBE]);
     assert_eq!(sp.name(), "FINGER_SETPOINT_2");
     assert!((sp.force() - 12.34).abs() < 1e-9);
     assert_eq!(sp.force_raw(), 1234);
@@ -28,7 +31,7 @@ fn setpoint_round_trips_through_bytes_and_frames() {
 
 #[test]
 fn out_of_range_values_are_refused_not_wrapped() {
-    let err = FingerSetpoint::new(0, FingerMode::Active, 50.01, 0.0).expect_err("force too big");
+    let err = FingerSetpoint::new(0, FingerMode::Active, 50.01, 0.0, 0).expect_err("force too big");
     assert!(
         matches!(
             err,
@@ -39,10 +42,10 @@ fn out_of_range_values_are_refused_not_wrapped() {
         ),
         "{err}"
     );
-    assert!(FingerSetpoint::new(0, FingerMode::Active, f64::NAN, 0.0).is_err());
-    assert!(FingerSetpoint::new(0, FingerMode::Active, 0.0, -20.001).is_err());
-    assert!(FingerSetpoint::new(5, FingerMode::Active, 0.0, 0.0).is_err());
-    let mut sp = FingerSetpoint::new(0, FingerMode::Hold, 50.0, 20.0).expect("limits inclusive");
+    assert!(FingerSetpoint::new(0, FingerMode::Active, f64::NAN, 0.0, 0).is_err());
+    assert!(FingerSetpoint::new(0, FingerMode::Active, 0.0, -20.001, 0).is_err());
+    assert!(FingerSetpoint::new(5, FingerMode::Active, 0.0, 0.0, 0).is_err());
+    let mut sp = FingerSetpoint::new(0, FingerMode::Hold, 50.0, 20.0, 0).expect("limits inclusive");
     assert!(sp.set_counter(16).is_err());
     assert!(sp.set_force_raw(5001).is_err());
     assert_eq!(
@@ -73,14 +76,23 @@ fn decode_refuses_bad_frames() {
             ..
         })
     ));
+    // A setpoint of the 6-byte layout before the epoch is refused, not misread.
+    assert!(matches!(
+        decode(0x200, &[0; 6]),
+        Err(CodecError::WrongLength {
+            expected: 8,
+            got: 6,
+            ..
+        })
+    ));
     // Mode 4 is not in the FingerMode value table.
     assert!(matches!(
-        decode(0x200, &[0, 0x40, 0, 0, 0, 0]),
+        decode(0x200, &[0, 0x40, 0, 0, 0, 0, 0, 0]),
         Err(CodecError::UnknownValue { signal: "Mode", .. })
     ));
     // Force raw 0x7FFF exceeds the DBC max of 50 N.
     assert!(matches!(
-        decode(0x200, &[0, 0, 0xFF, 0x7F, 0, 0]),
+        decode(0x200, &[0, 0, 0xFF, 0x7F, 0, 0, 0, 0]),
         Err(CodecError::RawOutOfRange {
             signal: "Force",
             ..
@@ -131,7 +143,7 @@ fn diag_labels_are_checked_and_protected_messages_carry_valid_crc() {
     assert!((diag.label4() + 0.55).abs() < 1e-12);
     assert!(HandDiag::new(250, 0, 3, 1.05, 0.0, 0.0, 0.0, 0.0, 0).is_err());
 
-    let sp = FingerSetpoint::new(4, FingerMode::SafeStop, 0.0, 0.0).expect("valid");
+    let sp = FingerSetpoint::new(4, FingerMode::SafeStop, 0.0, 0.0, 0).expect("valid");
     let mut tx = E2eProtector::new(sp.e2e());
     let mut rx = E2eChecker::try_new(FingerSetpoint::E2E[4], 1).expect("valid config");
     for _ in 0..20 {
@@ -148,7 +160,7 @@ fn diag_labels_are_checked_and_protected_messages_carry_valid_crc() {
 
 #[test]
 fn physical_values_round_to_the_nearest_step_within_the_range() {
-    let mut sp = FingerSetpoint::new(0, FingerMode::Active, 0.0, 0.0).expect("valid");
+    let mut sp = FingerSetpoint::new(0, FingerMode::Active, 0.0, 0.0, 0).expect("valid");
     sp.set_force(12.344).expect("in range");
     assert_eq!(sp.force_raw(), 1234);
     sp.set_force(-12.346).expect("in range");

@@ -232,7 +232,12 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         }
         match self.transport.reopen() {
             Ok(()) => {
-                tracing::warn!("bus reopened; the daemon stays SAFE until `handctl arm`");
+                // Frames of the old epoch may still be queued where we cannot purge them.
+                self.engine.new_epoch();
+                tracing::warn!(
+                    epoch = self.engine.epoch(),
+                    "bus reopened in a new setpoint epoch; the daemon stays SAFE until `handctl arm`"
+                );
                 self.bus_ok = true;
                 true
             }

@@ -153,11 +153,13 @@ impl<K: Clock> Transport for SocketCanTransport<K> {
         // out after the bus recovers: under error-passive the controller keeps retrying them;
         // after bus-off it depends on the driver and the restart (a carrier drop resets the
         // qdisc; a controller restart may or may not clear the mailboxes). Such a stale
-        // setpoint passes the motor controller's E2E check (its counter was in sequence) and
-        // is followed by our safe stops, not replaced by them. Purging needs CAP_NET_ADMIN,
-        // which handd does not use for this: `tc qdisc replace dev <if> root pfifo_fast`
-        // flushes the qdisc; `ip link set <if> down` stops the controller and drops what it
-        // holds. (vcan has no queue: nothing is ever pending there.)
+        // setpoint passes the motor controller's E2E check (its counter was in sequence).
+        // Purging needs CAP_NET_ADMIN, which handd does not have: `tc qdisc replace dev <if>
+        // root pfifo_fast` flushes the qdisc; `ip link set <if> down` stops the controller and
+        // drops what it holds. (vcan has no queue: nothing is ever pending there.) What makes
+        // such a frame harmless is the setpoint epoch (hand.dbc, can-dbc/README.md): the
+        // daemon comes back in a new epoch and opens it with a SAFE_STOP, after which the
+        // controller ignores every frame of the old one.
         self.socket = None;
     }
 

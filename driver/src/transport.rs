@@ -38,7 +38,7 @@ pub trait Transport {
     /// After a bus failure: drop what this transport can of the frames queued for sending and
     /// not yet on the bus (a stale setpoint should never reach a motor). What can be dropped
     /// depends on the transport: SocketCAN cannot purge the kernel's and the controller's
-    /// queues (see its implementation).
+    /// queues (see its implementation); the setpoint epoch makes what is left harmless.
     fn drop_queued(&mut self);
     /// Try to bring the bus back (reopen the socket).
     fn reopen(&mut self) -> Result<(), TransportError>;

@@ -160,7 +160,7 @@ fn good_setpoints_never_brake_and_motion_stays_in_range() {
 }
 
 #[test]
-fn resumes_when_valid_setpoints_return_and_obeys_estop_release() {
+fn resumes_only_in_a_new_epoch_after_a_timeout_and_obeys_estop_release() {
     use hand_dbc::messages::{EstopReason, EstopRequest, EstopSource, HandEstop};
     use hand_model::dbc::seal;
 
@@ -183,6 +183,9 @@ fn resumes_when_valid_setpoints_return_and_obeys_estop_release() {
         match t {
             500_000 => sp.set_corruption(SetpointCorruption::Silent),
             800_000 => sp.set_corruption(SetpointCorruption::None),
+            // Braking by itself retired the epoch: only a new one, opened by a SAFE_STOP,
+            // moves the finger again.
+            950_000 => sp.new_epoch(),
             1_200_000 => {
                 tool_ep
                     .transmit(&estop(EstopRequest::Stop, 0))
@@ -212,9 +215,30 @@ fn resumes_when_valid_setpoints_return_and_obeys_estop_release() {
     assert_eq!(state_at(480_000), FingerState::Active);
     assert_eq!(state_at(780_000), FingerState::Braked, "timed out");
     assert_eq!(
-        state_at(1_000_000),
+        state_at(940_000),
+        FingerState::Braked,
+        "valid setpoints of the epoch it braked in do not release the brake"
+    );
+    let stale_flagged = h
+        .with_id(FingerStatus::IDS[FINGER])
+        .into_iter()
+        .filter(|(t, _)| (800_000..=960_000).contains(t))
+        .any(|(_, f)| {
+            FingerStatus::decode(f.raw_id(), f.data())
+                .expect("valid")
+                .faults()
+                & (1 << 6)
+                != 0
+        });
+    assert!(
+        stale_flagged,
+        "ignored stale-epoch setpoints are reported (fault bit 6)"
+    );
+    assert_eq!(mc.epoch_gate().bound(), Some(1), "bound to the new epoch");
+    assert_eq!(
+        state_at(1_150_000),
         FingerState::Active,
-        "recovered on valid setpoints"
+        "recovered on a SAFE_STOP of a new epoch and ACTIVE after it"
     );
     assert_eq!(state_at(1_500_000), FingerState::Braked, "E-stop latched");
     assert_eq!(state_at(1_900_000), FingerState::Active, "released");

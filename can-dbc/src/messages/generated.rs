@@ -2752,9 +2752,9 @@ impl crate::e2e::Protected for EmgStatus {
 
 /// Messages FINGER_SETPOINT_0, FINGER_SETPOINT_1, FINGER_SETPOINT_2, FINGER_SETPOINT_3, FINGER_SETPOINT_4 (one per instance, ids 0x200, 0x201, 0x202, 0x203, 0x204), as one type with an instance index.
 ///
-/// Setpoint for finger 0 (thumb), 20 Hz, one per handd tick (50 ms). The motor controller brakes by itself when setpoints stop for 150 ms.
+/// Setpoint for finger 0 (thumb), 20 Hz, one per handd tick (50 ms). The motor controller brakes by itself when setpoints stop for 150 ms. No stale setpoint can move a finger: every setpoint carries handd's epoch (signal Epoch), and the controller follows a setpoint only in the epoch it is bound to, which only a SAFE_STOP setpoint opens (rule at signal Epoch; can-dbc/README.md, section The setpoint epoch).
 ///
-/// DLC 6, every 50 ms, sent by HAND, received by MC_0. E2E protected: CRC-8 in byte 0, 4-bit alive counter (data id 0x1200 for instance 0)
+/// DLC 8, every 50 ms, sent by HAND, received by MC_0. E2E protected: CRC-8 in byte 0, 4-bit alive counter (data id 0x2200 for instance 0)
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct FingerSetpoint {
     instance: u8,
@@ -2763,6 +2763,7 @@ pub struct FingerSetpoint {
     mode: FingerMode,
     force: i16,
     velocity: i16,
+    epoch: u16,
 }
 
 impl FingerSetpoint {
@@ -2781,16 +2782,16 @@ impl FingerSetpoint {
     /// CAN id of each instance.
     pub const IDS: [u32; 5] = [0x200, 0x201, 0x202, 0x203, 0x204];
     /// Payload length in bytes.
-    pub const DLC: usize = 6;
+    pub const DLC: usize = 8;
     /// Send period from `GenMsgCycleTime` (ms).
     pub const CYCLE_TIME_MS: u32 = 50;
     /// E2E profile of each instance.
     pub const E2E: [E2eProfile; 5] = [
-        E2eProfile::from_dbc(0x1200, 4, 6),
-        E2eProfile::from_dbc(0x1201, 4, 6),
-        E2eProfile::from_dbc(0x1202, 4, 6),
-        E2eProfile::from_dbc(0x1203, 4, 6),
-        E2eProfile::from_dbc(0x1204, 4, 6),
+        E2eProfile::from_dbc(0x2200, 4, 8),
+        E2eProfile::from_dbc(0x2201, 4, 8),
+        E2eProfile::from_dbc(0x2202, 4, 8),
+        E2eProfile::from_dbc(0x2203, 4, 8),
+        E2eProfile::from_dbc(0x2204, 4, 8),
     ];
     /// Smallest allowed `Crc` (crc).
     pub const CRC_MIN: u8 = 0;
@@ -2824,6 +2825,10 @@ impl FingerSetpoint {
     pub const VELOCITY_RAW_MIN: i16 = -20000;
     /// Largest allowed raw `Velocity` on the bus.
     pub const VELOCITY_RAW_MAX: i16 = 20000;
+    /// Smallest allowed `Epoch` (epoch).
+    pub const EPOCH_MIN: u16 = 0;
+    /// Largest allowed `Epoch` (epoch).
+    pub const EPOCH_MAX: u16 = 65535;
 
     /// Builds the message from physical values, each checked against hand.dbc. Crc and Counter start at 0: an [`crate::e2e::E2eProtector`] fills them when sending.
     pub fn new(
@@ -2831,6 +2836,7 @@ impl FingerSetpoint {
         mode: FingerMode,
         force: f64,
         velocity: f64,
+        epoch: u16,
     ) -> Result<Self, CodecError> {
         if instance >= 5 {
             return Err(CodecError::InstanceOutOfRange {
@@ -2846,10 +2852,12 @@ impl FingerSetpoint {
             mode: FingerMode::ALL[0],
             force: 0,
             velocity: 0,
+            epoch: 0,
         };
         msg.set_mode(mode);
         msg.set_force(force)?;
         msg.set_velocity(velocity)?;
+        msg.set_epoch(epoch)?;
         Ok(msg)
     }
 
@@ -3028,6 +3036,17 @@ impl FingerSetpoint {
         Ok(())
     }
 
+    /// `Epoch` (epoch): Setpoint epoch. handd draws a fresh, unpredictable epoch at every start and takes the next one (+1 modulo 65536) on every bus recovery (reopen after bus-off or link down), every change of state into SAFE and every report of a controller that braked by itself; in each epoch it sends a finger SAFE_STOP before anything else. The controller is bound to at most one epoch and remembers the last one it left (retired). A valid SAFE_STOP of an epoch that is not retired binds the controller to it (retiring the previous one); every other setpoint (ACTIVE, HOLD, DISABLED) is followed only if its epoch is the bound one, and a setpoint of the retired epoch, or of any epoch but the bound one, is ignored and counted. At power-up the controller is bound to none; when it brakes by itself (no valid setpoint for 150 ms) it retires its epoch and is bound to none, so it moves again only after a SAFE_STOP of a new epoch. Epochs are compared for equality only, so the counter wraps freely; within one run of handd an epoch repeats only after 65536 changes.
+    pub fn epoch(&self) -> u16 {
+        self.epoch
+    }
+
+    /// Sets `Epoch`; refuses values outside [0, 65535].
+    pub fn set_epoch(&mut self, value: u16) -> Result<(), CodecError> {
+        self.epoch = value;
+        Ok(())
+    }
+
     /// Decodes a payload; refuses a wrong length, raw values outside the DBC range and values the value tables do not name. The CRC is not checked here: that is [`crate::e2e::E2eChecker`]'s job.
     pub fn decode(id: u32, data: &[u8]) -> Result<Self, CodecError> {
         let Some(instance) = Self::instance_of(id) else {
@@ -3077,6 +3096,7 @@ impl FingerSetpoint {
                 max: 20000,
             });
         }
+        let epoch = ((bits >> 48) & 0xffff) as u16;
         Ok(Self {
             instance: instance as u8,
             crc,
@@ -3084,20 +3104,20 @@ impl FingerSetpoint {
             mode,
             force,
             velocity,
+            epoch,
         })
     }
 
     /// The payload bytes (values were range-checked when set, so this cannot fail).
-    pub fn encode(&self) -> [u8; 6] {
+    pub fn encode(&self) -> [u8; 8] {
         let mut bits = 0u64;
         bits |= u64::from(self.crc) & 0xff;
         bits |= (u64::from(self.counter) & 0xf) << 8;
         bits |= (u64::from(self.mode.raw()) & 0xf) << 12;
         bits |= ((i64::from(self.force) as u64) & 0xffff) << 16;
         bits |= ((i64::from(self.velocity) as u64) & 0xffff) << 32;
-        let mut out = [0u8; 6];
-        out.copy_from_slice(&bits.to_le_bytes()[..6]);
-        out
+        bits |= (u64::from(self.epoch) & 0xffff) << 48;
+        bits.to_le_bytes()
     }
 
     /// The message as a [`CanFrame`].
@@ -3123,6 +3143,7 @@ impl FingerSetpoint {
         f("Mode", f64::from(self.mode.raw()));
         f("Force", self.force());
         f("Velocity", self.velocity());
+        f("Epoch", f64::from(self.epoch));
     }
 
     /// Builds the message from physical values looked up by DBC signal name (enums by raw value), each checked; E2E signals included.
@@ -3145,6 +3166,7 @@ impl FingerSetpoint {
             mode: FingerMode::ALL[0],
             force: 0,
             velocity: 0,
+            epoch: 0,
         };
         let v = get("Crc").ok_or(CodecError::MissingSignal {
             message,
@@ -3192,6 +3214,19 @@ impl FingerSetpoint {
             signal: "Velocity",
         })?;
         msg.set_velocity(v)?;
+        let v = get("Epoch").ok_or(CodecError::MissingSignal {
+            message,
+            signal: "Epoch",
+        })?;
+        let raw = whole(message, "Epoch", v)?;
+        let raw = u16::try_from(raw).map_err(|_| CodecError::RawOutOfRange {
+            message,
+            signal: "Epoch",
+            raw,
+            min: 0,
+            max: 65535,
+        })?;
+        msg.set_epoch(raw)?;
         Ok(msg)
     }
 }
@@ -3563,7 +3598,7 @@ impl FingerStatus {
         Ok(())
     }
 
-    /// `Faults` (bitmask): bit 0 over-current, bit 1 over-temperature, bit 2 encoder, bit 3 setpoint timeout (braked), bit 4 E2E error on setpoints, bit 5 joint limit.
+    /// `Faults` (bitmask): bit 0 over-current, bit 1 over-temperature, bit 2 encoder, bit 3 setpoint timeout (braked), bit 4 E2E error on setpoints, bit 5 joint limit, bit 6 setpoint ignored by the epoch rule (a valid setpoint of a stale or not yet opened epoch, see FINGER_SETPOINT Epoch) since the previous status.
     pub fn faults(&self) -> u8 {
         self.faults
     }
@@ -5018,28 +5053,29 @@ pub const MESSAGES: &[MessageInfo] = &[
     MessageInfo {
         name: "FINGER_SETPOINT_0",
         id: 0x200,
-        dlc: 6,
+        dlc: 8,
         cycle_time_ms: 50,
         senders: &["HAND"],
         receivers: &["MC_0"],
-        e2e: Some(E2eProfile::from_dbc(0x1200, 4, 6)),
-        comment: "Setpoint for finger 0 (thumb), 20 Hz, one per handd tick (50 ms). The motor controller brakes by itself when setpoints stop for 150 ms.",
+        e2e: Some(E2eProfile::from_dbc(0x2200, 4, 8)),
+        comment: "Setpoint for finger 0 (thumb), 20 Hz, one per handd tick (50 ms). The motor controller brakes by itself when setpoints stop for 150 ms. No stale setpoint can move a finger: every setpoint carries handd's epoch (signal Epoch), and the controller follows a setpoint only in the epoch it is bound to, which only a SAFE_STOP setpoint opens (rule at signal Epoch; can-dbc/README.md, section The setpoint epoch).",
         signals: &[
             SignalInfo { name: "Crc", start_bit: 0, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "crc", values: &[], comment: "" },
             SignalInfo { name: "Counter", start_bit: 8, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 15.0, raw_min: 0, raw_max: 15, unit: "count", values: &[], comment: "" },
             SignalInfo { name: "Mode", start_bit: 12, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 3.0, raw_min: 0, raw_max: 3, unit: "enum", values: &[(0, "DISABLED"), (1, "ACTIVE"), (2, "HOLD"), (3, "SAFE_STOP")], comment: "DISABLED: motor off; ACTIVE: follow force and velocity; HOLD: keep position; SAFE_STOP: zero force, zero velocity, brake." },
             SignalInfo { name: "Force", start_bit: 16, size: 16, signed: true, factor: 0.01, offset: 0.0, min: -50.0, max: 50.0, raw_min: -5000, raw_max: 5000, unit: "N", values: &[], comment: "Force setpoint, flexion positive. handd sends 0 in SAFE_STOP." },
             SignalInfo { name: "Velocity", start_bit: 32, size: 16, signed: true, factor: 0.001, offset: 0.0, min: -20.0, max: 20.0, raw_min: -20000, raw_max: 20000, unit: "rad/s", values: &[], comment: "Joint velocity setpoint, flexion positive." },
+            SignalInfo { name: "Epoch", start_bit: 48, size: 16, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 65535.0, raw_min: 0, raw_max: 65535, unit: "epoch", values: &[], comment: "Setpoint epoch. handd draws a fresh, unpredictable epoch at every start and takes the next one (+1 modulo 65536) on every bus recovery (reopen after bus-off or link down), every change of state into SAFE and every report of a controller that braked by itself; in each epoch it sends a finger SAFE_STOP before anything else. The controller is bound to at most one epoch and remembers the last one it left (retired). A valid SAFE_STOP of an epoch that is not retired binds the controller to it (retiring the previous one); every other setpoint (ACTIVE, HOLD, DISABLED) is followed only if its epoch is the bound one, and a setpoint of the retired epoch, or of any epoch but the bound one, is ignored and counted. At power-up the controller is bound to none; when it brakes by itself (no valid setpoint for 150 ms) it retires its epoch and is bound to none, so it moves again only after a SAFE_STOP of a new epoch. Epochs are compared for equality only, so the counter wraps freely; within one run of handd an epoch repeats only after 65536 changes." },
         ],
     },
     MessageInfo {
         name: "FINGER_SETPOINT_1",
         id: 0x201,
-        dlc: 6,
+        dlc: 8,
         cycle_time_ms: 50,
         senders: &["HAND"],
         receivers: &["MC_1"],
-        e2e: Some(E2eProfile::from_dbc(0x1201, 4, 6)),
+        e2e: Some(E2eProfile::from_dbc(0x2201, 4, 8)),
         comment: "Setpoint for finger 1 (index), see FINGER_SETPOINT_0.",
         signals: &[
             SignalInfo { name: "Crc", start_bit: 0, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "crc", values: &[], comment: "" },
@@ -5047,16 +5083,17 @@ pub const MESSAGES: &[MessageInfo] = &[
             SignalInfo { name: "Mode", start_bit: 12, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 3.0, raw_min: 0, raw_max: 3, unit: "enum", values: &[(0, "DISABLED"), (1, "ACTIVE"), (2, "HOLD"), (3, "SAFE_STOP")], comment: "" },
             SignalInfo { name: "Force", start_bit: 16, size: 16, signed: true, factor: 0.01, offset: 0.0, min: -50.0, max: 50.0, raw_min: -5000, raw_max: 5000, unit: "N", values: &[], comment: "" },
             SignalInfo { name: "Velocity", start_bit: 32, size: 16, signed: true, factor: 0.001, offset: 0.0, min: -20.0, max: 20.0, raw_min: -20000, raw_max: 20000, unit: "rad/s", values: &[], comment: "" },
+            SignalInfo { name: "Epoch", start_bit: 48, size: 16, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 65535.0, raw_min: 0, raw_max: 65535, unit: "epoch", values: &[], comment: "" },
         ],
     },
     MessageInfo {
         name: "FINGER_SETPOINT_2",
         id: 0x202,
-        dlc: 6,
+        dlc: 8,
         cycle_time_ms: 50,
         senders: &["HAND"],
         receivers: &["MC_2"],
-        e2e: Some(E2eProfile::from_dbc(0x1202, 4, 6)),
+        e2e: Some(E2eProfile::from_dbc(0x2202, 4, 8)),
         comment: "Setpoint for finger 2 (middle), see FINGER_SETPOINT_0.",
         signals: &[
             SignalInfo { name: "Crc", start_bit: 0, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "crc", values: &[], comment: "" },
@@ -5064,16 +5101,17 @@ pub const MESSAGES: &[MessageInfo] = &[
             SignalInfo { name: "Mode", start_bit: 12, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 3.0, raw_min: 0, raw_max: 3, unit: "enum", values: &[(0, "DISABLED"), (1, "ACTIVE"), (2, "HOLD"), (3, "SAFE_STOP")], comment: "" },
             SignalInfo { name: "Force", start_bit: 16, size: 16, signed: true, factor: 0.01, offset: 0.0, min: -50.0, max: 50.0, raw_min: -5000, raw_max: 5000, unit: "N", values: &[], comment: "" },
             SignalInfo { name: "Velocity", start_bit: 32, size: 16, signed: true, factor: 0.001, offset: 0.0, min: -20.0, max: 20.0, raw_min: -20000, raw_max: 20000, unit: "rad/s", values: &[], comment: "" },
+            SignalInfo { name: "Epoch", start_bit: 48, size: 16, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 65535.0, raw_min: 0, raw_max: 65535, unit: "epoch", values: &[], comment: "" },
         ],
     },
     MessageInfo {
         name: "FINGER_SETPOINT_3",
         id: 0x203,
-        dlc: 6,
+        dlc: 8,
         cycle_time_ms: 50,
         senders: &["HAND"],
         receivers: &["MC_3"],
-        e2e: Some(E2eProfile::from_dbc(0x1203, 4, 6)),
+        e2e: Some(E2eProfile::from_dbc(0x2203, 4, 8)),
         comment: "Setpoint for finger 3 (ring), see FINGER_SETPOINT_0.",
         signals: &[
             SignalInfo { name: "Crc", start_bit: 0, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "crc", values: &[], comment: "" },
@@ -5081,16 +5119,17 @@ pub const MESSAGES: &[MessageInfo] = &[
             SignalInfo { name: "Mode", start_bit: 12, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 3.0, raw_min: 0, raw_max: 3, unit: "enum", values: &[(0, "DISABLED"), (1, "ACTIVE"), (2, "HOLD"), (3, "SAFE_STOP")], comment: "" },
             SignalInfo { name: "Force", start_bit: 16, size: 16, signed: true, factor: 0.01, offset: 0.0, min: -50.0, max: 50.0, raw_min: -5000, raw_max: 5000, unit: "N", values: &[], comment: "" },
             SignalInfo { name: "Velocity", start_bit: 32, size: 16, signed: true, factor: 0.001, offset: 0.0, min: -20.0, max: 20.0, raw_min: -20000, raw_max: 20000, unit: "rad/s", values: &[], comment: "" },
+            SignalInfo { name: "Epoch", start_bit: 48, size: 16, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 65535.0, raw_min: 0, raw_max: 65535, unit: "epoch", values: &[], comment: "" },
         ],
     },
     MessageInfo {
         name: "FINGER_SETPOINT_4",
         id: 0x204,
-        dlc: 6,
+        dlc: 8,
         cycle_time_ms: 50,
         senders: &["HAND"],
         receivers: &["MC_4"],
-        e2e: Some(E2eProfile::from_dbc(0x1204, 4, 6)),
+        e2e: Some(E2eProfile::from_dbc(0x2204, 4, 8)),
         comment: "Setpoint for finger 4 (pinky), see FINGER_SETPOINT_0.",
         signals: &[
             SignalInfo { name: "Crc", start_bit: 0, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "crc", values: &[], comment: "" },
@@ -5098,6 +5137,7 @@ pub const MESSAGES: &[MessageInfo] = &[
             SignalInfo { name: "Mode", start_bit: 12, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 3.0, raw_min: 0, raw_max: 3, unit: "enum", values: &[(0, "DISABLED"), (1, "ACTIVE"), (2, "HOLD"), (3, "SAFE_STOP")], comment: "" },
             SignalInfo { name: "Force", start_bit: 16, size: 16, signed: true, factor: 0.01, offset: 0.0, min: -50.0, max: 50.0, raw_min: -5000, raw_max: 5000, unit: "N", values: &[], comment: "" },
             SignalInfo { name: "Velocity", start_bit: 32, size: 16, signed: true, factor: 0.001, offset: 0.0, min: -20.0, max: 20.0, raw_min: -20000, raw_max: 20000, unit: "rad/s", values: &[], comment: "" },
+            SignalInfo { name: "Epoch", start_bit: 48, size: 16, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 65535.0, raw_min: 0, raw_max: 65535, unit: "epoch", values: &[], comment: "" },
         ],
     },
     MessageInfo {
@@ -5116,7 +5156,7 @@ pub const MESSAGES: &[MessageInfo] = &[
             SignalInfo { name: "Position", start_bit: 16, size: 12, signed: false, factor: 0.001, offset: -0.5, min: -0.5, max: 2.0, raw_min: 0, raw_max: 2500, unit: "rad", values: &[], comment: "Joint angle, 0 = fully extended, flexion positive." },
             SignalInfo { name: "Velocity", start_bit: 28, size: 12, signed: true, factor: 0.01, offset: 0.0, min: -20.0, max: 20.0, raw_min: -2000, raw_max: 2000, unit: "rad/s", values: &[], comment: "" },
             SignalInfo { name: "Force", start_bit: 40, size: 12, signed: true, factor: 0.025, offset: 0.0, min: -50.0, max: 50.0, raw_min: -2000, raw_max: 2000, unit: "N", values: &[], comment: "" },
-            SignalInfo { name: "Faults", start_bit: 52, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "bitmask", values: &[], comment: "bit 0 over-current, bit 1 over-temperature, bit 2 encoder, bit 3 setpoint timeout (braked), bit 4 E2E error on setpoints, bit 5 joint limit." },
+            SignalInfo { name: "Faults", start_bit: 52, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "bitmask", values: &[], comment: "bit 0 over-current, bit 1 over-temperature, bit 2 encoder, bit 3 setpoint timeout (braked), bit 4 E2E error on setpoints, bit 5 joint limit, bit 6 setpoint ignored by the epoch rule (a valid setpoint of a stale or not yet opened epoch, see FINGER_SETPOINT Epoch) since the previous status." },
         ],
     },
     MessageInfo {

@@ -7,15 +7,19 @@
 //! per-finger watchdog; an E-stop latches SAFE. Each tick evaluates the faults (`faults`), runs
 //! the model on the window ending at the newest sample, conditions the labels and builds one
 //! FINGER_SETPOINT per finger, plus HAND_DIAG every tick and HAND_HEARTBEAT every other tick
-//! (`tx`).
+//! (`tx`). Every setpoint carries the current setpoint epoch (`epoch`), and a finger gets a
+//! SAFE_STOP first in each epoch, so no stale setpoint can move a finger.
 //!
 //! After construction nothing here allocates (a test counts), returns a `Result` on the tick
 //! path or panics on any frame: every out-of-range value was excluded by validating the
 //! config, so encoding a setpoint cannot fail, and if it ever did the finger gets a safe stop.
 
+mod epoch;
 mod faults;
 mod rx;
 mod tx;
+
+pub use epoch::fresh_epoch;
 
 use decoder::dsp::ChainSettings;
 use decoder::model::Predictor;
@@ -124,12 +128,14 @@ pub struct Engine {
     counters: Counters,
     timing: TickTiming,
     tx: tx::Tx,
+    epochs: epoch::Epochs,
     transitions: [Option<Transition>; 8],
     finger_events: [Option<FingerEvent>; N_FINGERS],
 }
 
 impl Engine {
-    /// An engine in BOOT for the chain `settings` and a model's `predictor`, at time `now_us`.
+    /// An engine in BOOT for the chain `settings` and a model's `predictor`, at time `now_us`,
+    /// in a fresh setpoint epoch ([`fresh_epoch`]; [`Engine::begin_epoch`] sets another).
     /// Panics if the predictor does not take the chain's feature count: the daemon checks the
     /// model against the chain before it gets here.
     pub fn new(
@@ -164,6 +170,7 @@ impl Engine {
             counters: Counters::default(),
             timing: TickTiming::default(),
             tx: tx::Tx::new(),
+            epochs: epoch::Epochs::new(fresh_epoch()),
             transitions: [None; 8],
             finger_events: [None; N_FINGERS],
             settings,
@@ -172,10 +179,34 @@ impl Engine {
 
     fn note(&mut self, t: Option<Transition>) {
         if let Some(t) = t {
+            if t.to == DaemonState::Safe {
+                self.epochs.next();
+            }
             if let Some(slot) = self.transitions.iter_mut().find(|s| s.is_none()) {
                 *slot = Some(t);
             }
         }
+    }
+
+    /// Starts setpoint epoch `epoch` (a replay takes the recorded one): every finger gets a
+    /// SAFE_STOP of it before anything else.
+    pub fn begin_epoch(&mut self, epoch: u16) {
+        self.epochs.begin(epoch);
+    }
+
+    /// Starts the next setpoint epoch: the daemon calls it when the bus comes back.
+    pub fn new_epoch(&mut self) {
+        self.epochs.next();
+    }
+
+    /// The setpoint epoch the frames carry now.
+    pub fn epoch(&self) -> u16 {
+        self.epochs.current()
+    }
+
+    /// Setpoint epochs begun since start, the first included.
+    pub fn epochs_begun(&self) -> u64 {
+        self.epochs.begun()
     }
 
     /// Config, model and bus are validated: BOOT -> READY.

@@ -6,13 +6,16 @@ use decoder::dsp::{Chain, ChainSettings};
 use hand_dbc::e2e::{E2eChecker, E2eProfile, E2eStatus};
 use hand_dbc::emg_front::{EmgFront, EmgFrontConfig, EmgFrontSettings, FrameVerdict};
 use hand_dbc::messages::{
-    self, AmpState, EmgStatus, EstopRequest, FingerStatus, HandEstop, Message,
+    self, AmpState, EmgStatus, EstopRequest, FingerState, FingerStatus, HandEstop, Message,
 };
 use hand_dbc::CanFrame;
 
 use super::Engine;
 use crate::safety::Fault;
 use crate::units::N_FINGERS;
+
+/// FINGER_STATUS fault bit 3 (hand.dbc): the controller braked by itself, setpoint timeout.
+const STATUS_SETPOINT_TIMEOUT: u8 = 1 << 3;
 
 /// The EMG stream: the front end, the signal chain it feeds and what the tick needs to know
 /// about the newest samples.
@@ -182,6 +185,12 @@ impl Engine {
                         self.watch.heard(f, rx_us);
                         self.inputs.reported_force[f] = s.force();
                         self.inputs.reported_position[f] = s.position();
+                        // It retired our epoch: only a new one's SAFE_STOP moves it again.
+                        let self_braked = s.state() == FingerState::Braked
+                            && s.faults() & STATUS_SETPOINT_TIMEOUT != 0;
+                        if self.epochs.on_status(f, self_braked) {
+                            self.epochs.next();
+                        }
                     }
                     E2eStatus::Repeated => {}
                     _ => self.counters.e2e_errors += 1,

@@ -47,11 +47,12 @@ impl Tx {
         &self.frames[..self.len]
     }
 
-    /// The one setpoint-frame builder: finger `f`'s setpoint in `mode`, E2E-protected; a
-    /// setpoint the codec refuses becomes a safe stop (never happens with a validated config).
-    fn setpoint(&mut self, f: usize, mode: FingerMode, sp: &Setpoint) {
-        let frame = FingerSetpoint::new(f, mode, sp.force.0, sp.velocity.0)
-            .or_else(|_| FingerSetpoint::new(f, FingerMode::SafeStop, 0.0, 0.0))
+    /// The one setpoint-frame builder: finger `f`'s setpoint in `mode` and `epoch`,
+    /// E2E-protected; a setpoint the codec refuses becomes a safe stop (never happens with a
+    /// validated config).
+    fn setpoint(&mut self, f: usize, mode: FingerMode, sp: &Setpoint, epoch: u16) {
+        let frame = FingerSetpoint::new(f, mode, sp.force.0, sp.velocity.0, epoch)
+            .or_else(|_| FingerSetpoint::new(f, FingerMode::SafeStop, 0.0, 0.0, epoch))
             .ok()
             .and_then(|m| self.setpoint[f].protect_message(&m).ok());
         self.push(frame);
@@ -74,20 +75,26 @@ impl Engine {
         }
     }
 
-    /// Conditions the labels into setpoints (or stops the fingers) and builds their frames.
+    /// Conditions the labels into setpoints (or stops the fingers) and builds their frames, in
+    /// the current epoch: a finger not yet sent a SAFE_STOP in it gets one first.
     pub(super) fn build_setpoints(&mut self, running: bool) {
         let dt_s = self.settings.tick_us as f64 * 1e-6;
+        let epoch = self.epochs.current();
         for f in 0..N_FINGERS {
-            let mode = if running && !self.watch.is_disabled(f) {
+            let wanted = if running && !self.watch.is_disabled(f) {
+                FingerMode::Active
+            } else {
+                self.stopped_mode(f)
+            };
+            let mode = self.epochs.mode(f, wanted);
+            if mode == FingerMode::Active {
                 let gains = &self.settings.gains[f];
                 self.setpoints[f] = self.conditioners[f].step(self.labels[f], gains, dt_s);
-                FingerMode::Active
             } else {
                 self.conditioners[f].reset();
                 self.setpoints[f] = Setpoint::default();
-                self.stopped_mode(f)
-            };
-            self.tx.setpoint(f, mode, &self.setpoints[f]);
+            }
+            self.tx.setpoint(f, mode, &self.setpoints[f], epoch);
         }
     }
 

@@ -4,11 +4,13 @@
 //! over SocketCAN in `handsim`.
 
 pub mod amplifier;
+pub mod epoch;
 pub mod injector;
 pub mod motor;
 pub mod setpoints;
 
 pub use amplifier::{AmplifierNode, AmplifierNodeConfig};
+pub use epoch::EpochGate;
 pub use injector::FaultInjector;
 pub use motor::FingerNode;
 pub use setpoints::{SetpointCorruption, SetpointSource};

@@ -6,14 +6,19 @@
 //! counter or a counter jump does not, and raises the E2E fault bit. When no valid setpoint
 //! arrived for `setpoint_timeout_us` (150 ms), the brake engages: velocity and force go to
 //! zero at once, the state becomes BRAKED and fault bit 3 is set, so a killed daemon leaves a
-//! safe hand. A valid HAND_ESTOP STOP also brakes, until a valid RELEASE. Valid setpoints
-//! release a timeout brake (the first frame after a gap resynchronises the counter, so it
-//! takes two).
+//! safe hand. A valid HAND_ESTOP STOP also brakes, until a valid RELEASE.
+//!
+//! A setpoint that passed E2E is then judged by its epoch ([`super::epoch`]): the controller
+//! follows it only in the epoch it is bound to, which a SAFE_STOP opens; one it ignores sets
+//! fault bit 6 and feeds no watchdog. So after braking by itself (which retires its epoch)
+//! the controller moves again only after a SAFE_STOP of a new epoch (the first frame after a
+//! gap resynchronises the E2E counter, so it takes that frame and the SAFE_STOP after it).
 
 use hand_dbc::e2e::E2eChecker;
 use hand_dbc::e2e::E2eStatus;
 use hand_dbc::messages::{self, EstopRequest, FingerSetpoint, FingerStatus, HandEstop};
 
+use super::epoch::{EpochGate, Verdict};
 use super::{std_id, Bus, NodeStats};
 use crate::dbc::seal;
 use crate::error::SimError;
@@ -26,6 +31,9 @@ pub const FAULT_SETPOINT_TIMEOUT: u8 = 1 << 3;
 pub const FAULT_SETPOINT_E2E: u8 = 1 << 4;
 /// FINGER_STATUS fault bit 5: at a joint limit.
 pub const FAULT_JOINT_LIMIT: u8 = 1 << 5;
+/// FINGER_STATUS fault bit 6: a valid setpoint of a stale or unopened epoch was ignored since
+/// the previous status.
+pub const FAULT_STALE_EPOCH: u8 = 1 << 6;
 
 /// Counter steps accepted between two setpoints: one lost frame is tolerated.
 const SETPOINT_MAX_DELTA: u16 = 2;
@@ -38,6 +46,8 @@ pub struct FingerNode {
     phys: FingerPhysics,
     cmd: Command,
     checker: E2eChecker,
+    gate: EpochGate,
+    stale_since_status: bool,
     last_valid_us: Option<u64>,
     ever_valid: bool,
     timed_out: bool,
@@ -68,6 +78,8 @@ impl FingerNode {
             cfg,
             cmd: Command::default(),
             checker,
+            gate: EpochGate::new(),
+            stale_since_status: false,
             last_valid_us: None,
             ever_valid: false,
             timed_out: false,
@@ -129,6 +141,11 @@ impl FingerNode {
         self.stats
     }
 
+    /// The epoch rule's state: the bound and retired epochs, the setpoints it ignored.
+    pub fn epoch_gate(&self) -> &EpochGate {
+        &self.gate
+    }
+
     /// Reads setpoints and E-stops, runs the control loop up to `now_us`, sends status.
     pub fn poll<B: Bus>(&mut self, now_us: u64, bus: &mut B) {
         while let Some(frame) = self.stats.receive(bus) {
@@ -138,9 +155,13 @@ impl FingerNode {
         while self.last_step_us + dt_us <= now_us {
             self.last_step_us += dt_us;
             let t = self.last_step_us;
+            let was_timed_out = self.timed_out;
             self.timed_out = self
                 .last_valid_us
                 .is_some_and(|l| t.saturating_sub(l) >= self.cfg.setpoint_timeout_us);
+            if self.timed_out && !was_timed_out {
+                self.gate.braked_by_itself();
+            }
             let braked = self.braked();
             self.phys
                 .step(&self.cfg, &self.cmd, braked, dt_us as f64 * 1e-6);
@@ -158,6 +179,11 @@ impl FingerNode {
             let status = self.checker.check_frame(Some(frame));
             let decoded = messages::FingerSetpoint::decode(id, frame.data());
             match (status, decoded) {
+                (E2eStatus::Ok, Ok(sp))
+                    if self.gate.admit(sp.mode(), sp.epoch()) == Verdict::Ignore =>
+                {
+                    self.stale_since_status = true;
+                }
                 (E2eStatus::Ok, Ok(sp)) => {
                     self.cmd = Command {
                         mode: match sp.mode() {
@@ -189,6 +215,22 @@ impl FingerNode {
         }
     }
 
+    /// FINGER_STATUS's fault bits now; the ones about setpoints since the previous status
+    /// are cleared.
+    fn take_status_faults(&mut self) -> u8 {
+        let bits = [
+            (self.timed_out, FAULT_SETPOINT_TIMEOUT),
+            (self.e2e_errors_since_status, FAULT_SETPOINT_E2E),
+            (self.phys.at_limit, FAULT_JOINT_LIMIT),
+            (self.stale_since_status, FAULT_STALE_EPOCH),
+        ];
+        self.e2e_errors_since_status = false;
+        self.stale_since_status = false;
+        bits.iter()
+            .filter(|(on, _)| *on)
+            .fold(0, |acc, (_, b)| acc | b)
+    }
+
     fn send_status<B: Bus>(&mut self, t: u64, bus: &mut B) {
         self.status_frames += 1;
         let mut silent = false;
@@ -205,17 +247,7 @@ impl FingerNode {
                 _ => {}
             }
         }
-        let mut faults = 0u8;
-        if self.timed_out {
-            faults |= FAULT_SETPOINT_TIMEOUT;
-        }
-        if self.e2e_errors_since_status {
-            faults |= FAULT_SETPOINT_E2E;
-        }
-        if self.phys.at_limit {
-            faults |= FAULT_JOINT_LIMIT;
-        }
-        self.e2e_errors_since_status = false;
+        let faults = self.take_status_faults();
         let counter = self.status_counter;
         self.status_counter = (counter + 1) & 0x0F;
         if silent {

@@ -1,6 +1,11 @@
 //! A stand-in for the daemon's output side: sends FINGER_SETPOINT_f at 20 Hz, correctly or
 //! corrupted on purpose. Tests use it to exercise the motor controllers without a daemon;
 //! `handsim` uses it for scenarios that move the hand without a decoder.
+//!
+//! It keeps the epoch protocol as handd does (hand.dbc, FINGER_SETPOINT's `Epoch`): every
+//! frame carries its epoch, and the first frame of each epoch is a SAFE_STOP, whatever the
+//! command; [`SetpointSource::new_epoch`] starts the next epoch, [`SetpointSource::set_epoch`]
+//! lets a test play a stale sender.
 
 use hand_dbc::messages::{FingerMode, FingerSetpoint};
 
@@ -35,6 +40,8 @@ pub struct SetpointSource {
     velocity_rad_s: f64,
     corruption: SetpointCorruption,
     counter: u8,
+    epoch: u16,
+    opened: bool,
     next_us: u64,
     stats: NodeStats,
 }
@@ -53,6 +60,8 @@ impl SetpointSource {
             velocity_rad_s: 0.0,
             corruption: SetpointCorruption::None,
             counter: 0,
+            epoch: 0,
+            opened: false,
             next_us: start_us,
             stats: NodeStats::default(),
         })
@@ -65,12 +74,29 @@ impl SetpointSource {
         force_n: f64,
         velocity_rad_s: f64,
     ) -> Result<(), SimError> {
-        FingerSetpoint::new(self.finger, mode, force_n, velocity_rad_s)
+        FingerSetpoint::new(self.finger, mode, force_n, velocity_rad_s, self.epoch)
             .map_err(|e| SimError::BadScript(format!("setpoint: {e}")))?;
         self.mode = mode;
         self.force_n = force_n;
         self.velocity_rad_s = velocity_rad_s;
         Ok(())
+    }
+
+    /// The epoch of the frames it sends.
+    pub fn epoch(&self) -> u16 {
+        self.epoch
+    }
+
+    /// Starts the next epoch (+1, wrapping), opened by a SAFE_STOP as handd does.
+    pub fn new_epoch(&mut self) {
+        self.set_epoch(self.epoch.wrapping_add(1), true);
+    }
+
+    /// Sends in `epoch` from now on; with `open` its first frame is a SAFE_STOP, without it the
+    /// command goes out as it is (a stale sender replaying an old epoch).
+    pub fn set_epoch(&mut self, epoch: u16, open: bool) {
+        self.epoch = epoch;
+        self.opened = !open;
     }
 
     /// Switches corruption on or off.
@@ -91,8 +117,13 @@ impl SetpointSource {
             if self.corruption == SetpointCorruption::Silent {
                 continue;
             }
-            let Ok(msg) =
-                FingerSetpoint::new(self.finger, self.mode, self.force_n, self.velocity_rad_s)
+            let (mode, force, velocity) = if self.opened {
+                (self.mode, self.force_n, self.velocity_rad_s)
+            } else {
+                (FingerMode::SafeStop, 0.0, 0.0)
+            };
+            self.opened = true;
+            let Ok(msg) = FingerSetpoint::new(self.finger, mode, force, velocity, self.epoch)
             else {
                 // Unreachable: `set` checked the values against the DBC.
                 self.stats.tx_errors += 1;

@@ -14,6 +14,12 @@
 //! up to that sample's last frame. Should the setpoints not come out bit for bit there, it
 //! tries the other cut points of the last [`CUT_SEARCH_US`], latest first, and counts the tick
 //! as searched; a tick that matches at no cut point is a difference.
+//!
+//! Every setpoint carries handd's setpoint epoch, drawn at random when handd starts: the
+//! replay's engine begins in the epoch of the first setpoint in the log, and from there
+//! changes epoch by the same rules as handd (entry into SAFE, a controller's self-brake
+//! report, both read from the log's frames). A bus recovery also starts a new epoch in handd;
+//! it is not in the frames, so a log with one does not replay past it.
 
 use driver::engine::Engine;
 use hand_dbc::candump::LogEntry;
@@ -106,6 +112,11 @@ pub fn replay(config: &driver::Config, log: &[LogEntry]) -> ReplayReport {
         phase,
     );
     engine.validated(phase);
+    let first = &log[ticks[0].first].frame;
+    let epoch = FingerSetpoint::decode(first.raw_id(), first.data())
+        .expect("handd's first setpoint decodes")
+        .epoch();
+    engine.begin_epoch(epoch);
     let mut report = ReplayReport {
         same: 0,
         different: Vec::new(),

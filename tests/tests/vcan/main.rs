@@ -6,6 +6,8 @@
 //! Times are kernel receive timestamps of a monitor socket; handsim's scenario time 0 is the
 //! receive time of its first EMG sample (counter 0), so fault onsets are placed on the bus.
 
+mod epoch;
+mod monitor_tui;
 mod subscribers;
 
 use std::path::{Path, PathBuf};
@@ -22,8 +24,6 @@ use handstack_tests::vcan::{
     TestConfig, VcanEnv,
 };
 use socketcan::{EmbeddedFrame, Socket};
-
-mod monitor_tui;
 
 /// The daemon's safe-stop bar: setpoints on the bus at most this long after a fault's onset.
 const SAFE_STOP_BAR_US: u64 = 100_000;

@@ -1,0 +1,149 @@
+//! handd's side of the setpoint epoch (hand.dbc, FINGER_SETPOINT's `Epoch`): no stale
+//! setpoint can move a finger.
+//!
+//! Every setpoint carries the current epoch. The engine starts at a fresh, unpredictable
+//! epoch ([`fresh_epoch`]) and takes the next one (+1, wrapping) on every change of state into
+//! SAFE, on every bus recovery (the daemon calls [`super::Engine::new_epoch`] after a reopen)
+//! and when a finger controller reports that it braked by itself (FINGER_STATUS BRAKED with
+//! the setpoint-timeout bit, on the report's rising edge). In each epoch a finger gets a
+//! SAFE_STOP before anything else (DISABLED included): the controller opens an epoch only on a
+//! SAFE_STOP, and ignores every setpoint of another epoch, so frames of an older epoch still
+//! queued in the kernel or in a CAN controller's mailboxes cannot move the finger once the
+//! new epoch's SAFE_STOP has reached it.
+
+use std::hash::{BuildHasher, Hasher};
+
+use hand_dbc::messages::FingerMode;
+
+use crate::units::N_FINGERS;
+
+/// An epoch no earlier run can predict: from the process's random hash keys (the standard
+/// library seeds them from the operating system's random source) and the wall clock.
+pub fn fresh_epoch() -> u16 {
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    let now = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_nanos())
+        .unwrap_or(0);
+    h.write_u128(now);
+    let x = h.finish();
+    (x ^ (x >> 16) ^ (x >> 32) ^ (x >> 48)) as u16
+}
+
+/// The current epoch and which fingers it was opened for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) struct Epochs {
+    epoch: u16,
+    /// Finger f got a SAFE_STOP of this epoch.
+    opened: [bool; N_FINGERS],
+    /// Finger f's last status said it braked by itself.
+    self_braked: [bool; N_FINGERS],
+    /// Epochs begun since start, the first included.
+    begun: u64,
+}
+
+impl Epochs {
+    pub(super) fn new(epoch: u16) -> Self {
+        Self {
+            epoch,
+            opened: [false; N_FINGERS],
+            self_braked: [false; N_FINGERS],
+            begun: 1,
+        }
+    }
+
+    /// The epoch the setpoints carry now.
+    pub(super) fn current(&self) -> u16 {
+        self.epoch
+    }
+
+    /// Epochs begun since start.
+    pub(super) fn begun(&self) -> u64 {
+        self.begun
+    }
+
+    /// Starts `epoch`: no finger has had its SAFE_STOP yet.
+    pub(super) fn begin(&mut self, epoch: u16) {
+        self.epoch = epoch;
+        self.opened = [false; N_FINGERS];
+        self.begun += 1;
+    }
+
+    /// Starts the next epoch.
+    pub(super) fn next(&mut self) {
+        self.begin(self.epoch.wrapping_add(1));
+    }
+
+    /// The mode to send finger `f` when the engine wants `wanted`: a SAFE_STOP in place of
+    /// anything else until the finger got one in this epoch. DISABLED too: a controller that
+    /// handd cannot hear may still hear handd, and it must leave its old epoch.
+    pub(super) fn mode(&mut self, f: usize, wanted: FingerMode) -> FingerMode {
+        if self.opened[f] {
+            return wanted;
+        }
+        self.opened[f] = true;
+        FingerMode::SafeStop
+    }
+
+    /// Finger `f` reported its state: true when it newly says it braked by itself, which
+    /// calls for a new epoch (it retired the current one).
+    pub(super) fn on_status(&mut self, f: usize, braked_by_itself: bool) -> bool {
+        let rising = braked_by_itself && !self.self_braked[f];
+        self.self_braked[f] = braked_by_itself;
+        rising
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use FingerMode::{Active, Disabled, Hold, SafeStop};
+
+    #[test]
+    fn each_epoch_opens_every_finger_with_a_safe_stop_first() {
+        let mut e = Epochs::new(65535);
+        for f in 0..N_FINGERS {
+            assert_eq!(
+                e.mode(f, Active),
+                SafeStop,
+                "finger {f}: first frame of the epoch"
+            );
+            assert_eq!(e.mode(f, Active), Active);
+            assert_eq!(e.mode(f, Hold), Hold);
+        }
+        e.next();
+        assert_eq!(e.current(), 0, "wraps");
+        assert_eq!(e.begun(), 2);
+        assert_eq!(
+            e.mode(1, Disabled),
+            SafeStop,
+            "DISABLED opens with a stop too"
+        );
+        assert_eq!(e.mode(1, Disabled), Disabled);
+        assert_eq!(e.mode(1, Hold), Hold);
+        assert_eq!(e.mode(2, SafeStop), SafeStop);
+        assert_eq!(
+            e.mode(2, Active),
+            Active,
+            "opened by the stop the engine wanted"
+        );
+    }
+
+    #[test]
+    fn only_the_rising_edge_of_a_self_brake_report_calls_for_a_new_epoch() {
+        let mut e = Epochs::new(3);
+        assert!(!e.on_status(0, false));
+        assert!(e.on_status(0, true));
+        assert!(!e.on_status(0, true), "the same brake, reported again");
+        assert!(e.on_status(1, true), "another finger");
+        assert!(!e.on_status(0, false));
+        assert!(e.on_status(0, true), "a new brake");
+    }
+
+    #[test]
+    fn fresh_epochs_differ_between_draws() {
+        // 8 draws of 16 bits all equal by chance: probability 2^-112.
+        let draws: Vec<u16> = (0..8).map(|_| fresh_epoch()).collect();
+        assert!(draws.iter().any(|&d| d != draws[0]), "{draws:?}");
+    }
+}
