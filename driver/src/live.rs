@@ -100,16 +100,18 @@ pub struct Live {
     pub bus_load: f64,
     /// Per EMG channel.
     pub channels: Vec<ChannelLive>,
-    /// Per channel rest level of the model's calibration, µV; `None` while model files do not
-    /// carry it (they do not yet).
+    /// Per channel rest level of the running model's calibration (the mean RMS feature over its
+    /// rest windows), µV; `None` when the model file does not carry it (older files, a
+    /// calibration without rest).
     pub rest_rms_uv: Option<Vec<f64>>,
     /// Per finger, 0 thumb .. 4 pinky.
     pub fingers: Vec<FingerLive>,
 }
 
 impl Live {
-    /// The live view of a tick's snapshot, for the model `model`. Off the tick: allocates.
-    pub fn from_snapshot(s: &Snapshot, model: &ModelInfo) -> Self {
+    /// The live view of a tick's snapshot, for the model `model` whose calibration's rest
+    /// levels are `rest_rms_uv`. Off the tick: allocates.
+    pub fn from_snapshot(s: &Snapshot, model: &ModelInfo, rest_rms_uv: Option<&[f64]>) -> Self {
         Self {
             t_us: s.t_us,
             tick: s.counters.ticks,
@@ -134,7 +136,7 @@ impl Live {
                     saturated: s.saturation_mask & (1 << c) != 0,
                 })
                 .collect(),
-            rest_rms_uv: None,
+            rest_rms_uv: rest_rms_uv.map(<[f64]>::to_vec),
             fingers: (0..N_FINGERS)
                 .map(|f| FingerLive {
                     label: s.setpoints[f].label,

@@ -89,6 +89,7 @@ impl Daemon {
                 kind: "ResDD".into(),
             },
             tick_us: 50_000,
+            rest_rms_uv: None,
         };
         let mut handler = ControlHandler::new(config.clone(), config_path.clone(), snapshot, tx);
         let server = ControlServer::bind(&config.control.socket, None)

@@ -59,7 +59,10 @@ fn a_live_line_matches_the_bus() {
         path: "m.hsm".into(),
         kind: "ResDD".into(),
     };
-    let live = Live::from_snapshot(&snap, &model);
+    let rest = [1.5; 12];
+    let live = Live::from_snapshot(&snap, &model, Some(&rest));
+    assert_eq!(live.rest_rms_uv.as_deref(), Some(&rest[..]));
+    assert_eq!(Live::from_snapshot(&snap, &model, None).rest_rms_uv, None);
     let t = live.t_us;
     assert_eq!(t, 3_000_000, "the last tick's deadline");
     assert_eq!(live.tick, 60);

@@ -128,6 +128,11 @@ pub struct MonitorArgs {
     /// Mains frequency the EMG chain notches for the bus and log sources, 50 or 60 Hz.
     #[arg(long, default_value_t = 50)]
     pub mains: u32,
+    /// For the bus and log sources: the model whose calibration rest levels are marked on the
+    /// channel bars, and whose signal chain computes them (instead of --mains); the daemon
+    /// sends its own.
+    #[arg(long, value_name = "FILE", conflicts_with = "mains")]
+    pub model: Option<PathBuf>,
 }
 
 fn parse_speed(s: &str) -> Result<f64, String> {

@@ -143,6 +143,7 @@ fn run(args: &Args) -> Result<(), String> {
             kind: loaded.model.model().kind().to_string(),
         },
         tick_us: config.tick_ms * 1000,
+        rest_rms_uv: loaded.model.rest_rms_uv().map(<[f64]>::to_vec),
     };
     let server = ControlServer::bind(&config.control.socket, config.control.group.as_deref())
         .map_err(|e| e.to_string())?

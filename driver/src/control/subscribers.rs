@@ -38,6 +38,8 @@ pub struct LiveFeed {
     pub model: ModelInfo,
     /// The loop's tick, µs.
     pub tick_us: u64,
+    /// The model's calibration rest level per channel, µV, when its file carries it.
+    pub rest_rms_uv: Option<Vec<f64>>,
 }
 
 impl std::fmt::Debug for LiveFeed {
@@ -128,7 +130,8 @@ impl Hub {
             }
             s.due = tick + s.every_ticks;
             let line = line.get_or_insert_with(|| {
-                let live = Live::from_snapshot(snap, &self.feed.model);
+                let live =
+                    Live::from_snapshot(snap, &self.feed.model, self.feed.rest_rms_uv.as_deref());
                 let mut text = serde_json::to_string(&live).unwrap_or_default();
                 text.push('\n');
                 Arc::from(text)

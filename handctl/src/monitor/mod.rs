@@ -27,6 +27,7 @@ use std::io::IsTerminal;
 use std::sync::mpsc::{sync_channel, Receiver};
 
 use decoder::dsp::{ChainConfig, ChainSettings};
+use decoder::model::TrainedModel;
 
 use self::cpu::CpuMeter;
 use self::feed::{Event, Monitor};
@@ -62,14 +63,27 @@ impl Source {
     }
 }
 
-/// `handctl monitor`.
-pub fn run(a: &MonitorArgs) -> Result<(), CliError> {
+/// The chain the bus and log sources run (the model's, with `--model`) and the rest levels
+/// to mark (the model's calibration's).
+fn chain_and_rest(a: &MonitorArgs) -> Result<(ChainSettings, Option<Vec<f64>>), CliError> {
+    if let Some(path) = &a.model {
+        let model = TrainedModel::load(path, None)?;
+        let settings = ChainSettings::try_new(model.chain())
+            .map_err(|e| CliError::Usage(format!("--model {}: its chain: {e}", path.display())))?;
+        return Ok((settings, model.rest_rms_uv().map(<[f64]>::to_vec)));
+    }
     let chain = ChainConfig {
         mains_hz: a.mains,
         ..ChainConfig::default()
     };
     let settings = ChainSettings::try_new(&chain)
         .map_err(|e| CliError::Usage(format!("--mains {}: {e}", a.mains)))?;
+    Ok((settings, None))
+}
+
+/// `handctl monitor`.
+pub fn run(a: &MonitorArgs) -> Result<(), CliError> {
+    let (settings, rest) = chain_and_rest(a)?;
     let finger = hand_dbc::hand::finger_index(&a.finger).ok_or_else(|| {
         CliError::Usage(format!(
             "--finger {:?}: expected thumb, index, middle, ring, pinky or 0-4",
@@ -84,6 +98,9 @@ pub fn run(a: &MonitorArgs) -> Result<(), CliError> {
     let cpu = CpuMeter::start();
     let tui = !a.plain && a.screen.is_none() && std::io::stdout().is_terminal();
     let mut m = Monitor::new(source.title(), &settings);
+    for (c, level) in m.state.channels.iter_mut().zip(rest.iter().flatten()) {
+        c.rest_uv = Some(*level);
+    }
     let mut view = View::with_finger(finger);
     let mut printer = PlainPrinter::default();
     let mut print_plain = |m: &Monitor| {
@@ -156,5 +173,51 @@ fn headless(
             m.apply(Event::End(format!("{s} s of data")));
             return;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::Parser;
+    use decoder::model::{AnyModel, ModelKind, ModelSpec, Normalizer, TrainingSummary};
+
+    use super::*;
+    use crate::args::{Cli, Command};
+
+    fn monitor_args(extra: &[&str]) -> MonitorArgs {
+        let cli = Cli::parse_from(["handctl", "monitor", "--log", "x.log"].iter().chain(extra));
+        match cli.command {
+            Command::Monitor(a) => a,
+            _ => unreachable!("parsed as monitor"),
+        }
+    }
+
+    #[test]
+    fn model_gives_the_chain_and_the_rest_levels_of_its_calibration() {
+        let chain = ChainConfig {
+            mains_hz: 60,
+            ..ChainConfig::default()
+        };
+        let n_in = 8 * chain.channels;
+        let spec = ModelSpec::default();
+        let model = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, 3).expect("model");
+        let norm = Normalizer::from_scales(vec![100.0; n_in]).expect("scales");
+        let summary = TrainingSummary::untrained(ModelKind::ResDd);
+        let levels: Vec<f64> = (0..chain.channels).map(|c| 2.0 + c as f64).collect();
+        let trained = TrainedModel::new(model, spec, norm, chain.clone(), summary)
+            .and_then(|m| m.with_rest_rms_uv(levels.clone()))
+            .expect("trained");
+        let path = std::env::temp_dir().join(format!("monitor-model-{}.hsm", std::process::id()));
+        trained.save(&path).expect("saved");
+
+        let (settings, rest) = chain_and_rest(&monitor_args(&["--model", path.to_str().unwrap()]))
+            .expect("the model's chain");
+        assert_eq!(rest, Some(levels));
+        assert_eq!(settings.config(), &chain, "the model's chain, mains 60 Hz");
+        let (settings, rest) = chain_and_rest(&monitor_args(&[])).expect("defaults");
+        assert_eq!((rest, settings.config().mains_hz), (None, 50));
+        let e = chain_and_rest(&monitor_args(&["--model", "/nonexistent.hsm"])).unwrap_err();
+        assert!(e.to_string().contains("/nonexistent.hsm"), "{e}");
+        std::fs::remove_file(&path).expect("removed");
     }
 }
