@@ -1,32 +1,15 @@
-//! The monitor's own CPU use: the kernel's account of this process's user and system time
-//! (`/proc/self/stat`, as getrusage reports it, in 10 ms clock ticks) over the wall time of the
-//! run.
+//! The monitor's own CPU use: the process's CPU time (all threads, user + system;
+//! `clock_gettime(CLOCK_PROCESS_CPUTIME_ID)` through `cpu-time`) over the wall time of the run.
 
 use std::time::Instant;
 
-/// Clock ticks per second of `/proc/<pid>/stat` (USER_HZ, 100 on every Linux ABI).
-const USER_HZ: f64 = 100.0;
-
-/// CPU time of this process (all threads, user + system), s; 0 where `/proc` cannot be read.
-fn process_cpu_s() -> f64 {
-    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
-        return 0.0;
-    };
-    // Fields after the command name (which may hold spaces, so split after its ')'): state is
-    // field 3, utime field 14, stime field 15.
-    let Some((_, rest)) = stat.rsplit_once(')') else {
-        return 0.0;
-    };
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let tick = |i: usize| f.get(i).and_then(|v| v.parse::<u64>().ok()).unwrap_or(0);
-    (tick(11) + tick(12)) as f64 / USER_HZ
-}
+use cpu_time::ProcessTime;
 
 /// Started at the beginning of a run.
 #[derive(Debug, Clone, Copy)]
 pub struct CpuMeter {
     wall: Instant,
-    cpu_s: f64,
+    cpu: ProcessTime,
 }
 
 impl CpuMeter {
@@ -34,14 +17,14 @@ impl CpuMeter {
     pub fn start() -> Self {
         Self {
             wall: Instant::now(),
-            cpu_s: process_cpu_s(),
+            cpu: ProcessTime::now(),
         }
     }
 
     /// (CPU seconds, wall seconds) since the start.
     pub fn used(&self) -> (f64, f64) {
         (
-            process_cpu_s() - self.cpu_s,
+            self.cpu.elapsed().as_secs_f64(),
             self.wall.elapsed().as_secs_f64(),
         )
     }
