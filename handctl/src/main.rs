@@ -18,6 +18,7 @@ mod demo;
 mod error;
 mod eval;
 mod import;
+mod listen;
 mod monitor;
 mod progress;
 mod record;

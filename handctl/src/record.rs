@@ -17,14 +17,14 @@
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
-use std::time::{Duration, Instant, UNIX_EPOCH};
+use std::time::{Duration, Instant};
 
 use decoder::dsp::ChainConfig;
 use decoder::session::{SessionMeta, Trial, TrialTable};
 use hand_dbc::candump::LogWriter;
 use hand_dbc::emg::EMG_CHANNELS;
 use hand_dbc::CanFrame;
-use socketcan::{CanSocket, EmbeddedFrame, Socket, SocketOptions};
+use socketcan::{CanSocket, EmbeddedFrame};
 
 use super::args::RecordArgs;
 use super::error::CliError;
@@ -95,19 +95,8 @@ pub fn run(a: &RecordArgs) -> Result<(), CliError> {
 }
 
 fn open(iface: &str) -> Result<CanSocket, CliError> {
-    driver::socketcan_bus::interface_up(iface)?;
-    let bad = |source| CliError::Can {
-        iface: iface.to_owned(),
-        what: "cannot open it".into(),
-        source,
-    };
-    let sock = CanSocket::open(iface).map_err(bad)?;
-    sock.set_recv_timestamp(true).map_err(bad)?;
-    sock.set_error_filter_accept_all().map_err(bad)?;
     // A short timeout so the recording ends on time on a silent bus.
-    sock.set_read_timeout(Duration::from_millis(50))
-        .map_err(bad)?;
-    Ok(sock)
+    super::listen::open(iface, Duration::from_millis(50), true)
 }
 
 fn record(sock: &CanSocket, iface: &str, path: &Path, seconds: f64) -> Result<Counts, CliError> {
@@ -116,16 +105,9 @@ fn record(sock: &CanSocket, iface: &str, path: &Path, seconds: f64) -> Result<Co
     let mut counts = Counts::default();
     let end = Instant::now() + Duration::from_secs_f64(seconds);
     while Instant::now() < end {
-        let (frame, ts) = match sock.read_frame_with_timestamp() {
-            Ok(x) => x,
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                ) =>
-            {
-                continue
-            }
+        let (frame, time_us) = match super::listen::read(sock) {
+            Ok(Some(x)) => x,
+            Ok(None) => continue,
             Err(source) => {
                 return Err(CliError::Can {
                     iface: iface.to_owned(),
@@ -134,10 +116,6 @@ fn record(sock: &CanSocket, iface: &str, path: &Path, seconds: f64) -> Result<Co
                 })
             }
         };
-        let time_us = ts
-            .duration_since(UNIX_EPOCH)
-            .map(|d| d.as_micros() as u64)
-            .unwrap_or(0);
         let ours = match frame {
             socketcan::CanFrame::Data(d) => CanFrame::new(d.id(), d.data()),
             socketcan::CanFrame::Remote(r) => CanFrame::new_remote(r.id(), r.dlc()),

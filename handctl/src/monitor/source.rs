@@ -7,12 +7,12 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::{Path, PathBuf};
 use std::sync::mpsc::SyncSender;
-use std::time::{Duration, Instant, UNIX_EPOCH};
+use std::time::{Duration, Instant};
 
 use driver::control::Subscription;
 use hand_dbc::candump::LogReader;
 use hand_dbc::CanFrame;
-use socketcan::{CanSocket, EmbeddedFrame, Socket, SocketOptions};
+use socketcan::{CanSocket, EmbeddedFrame};
 
 use super::feed::{Event, Monitor};
 use crate::error::CliError;
@@ -51,37 +51,17 @@ pub fn pump_daemon(subscription: Subscription, tx: SyncSender<Event>) {
 /// Opens `iface` for reading with kernel receive timestamps. A raw CAN socket that never
 /// writes: the monitor is listen-only on the bus.
 pub fn open_bus(iface: &str) -> Result<CanSocket, CliError> {
-    driver::socketcan_bus::interface_up(iface)?;
-    let bad = |source| CliError::Can {
-        iface: iface.to_owned(),
-        what: "cannot open it".into(),
-        source,
-    };
-    let sock = CanSocket::open(iface).map_err(bad)?;
-    sock.set_recv_timestamp(true).map_err(bad)?;
-    sock.set_read_timeout(Duration::from_millis(100))
-        .map_err(bad)?;
-    Ok(sock)
+    crate::listen::open(iface, Duration::from_millis(100), false)
 }
 
 /// Sends every data frame read from the bus, with its kernel receive time.
 pub fn pump_bus(sock: CanSocket, iface: String, tx: SyncSender<Event>) {
     let why = loop {
-        let (frame, ts) = match sock.read_frame_with_timestamp() {
-            Ok(x) => x,
-            Err(e)
-                if matches!(
-                    e.kind(),
-                    std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut
-                ) =>
-            {
-                continue
-            }
+        let (frame, t) = match crate::listen::read(&sock) {
+            Ok(Some(x)) => x,
+            Ok(None) => continue,
             Err(e) => break format!("reading {iface} failed: {e}"),
         };
-        let t = ts
-            .duration_since(UNIX_EPOCH)
-            .map_or(0, |d| d.as_micros() as u64);
         let ours = match frame {
             socketcan::CanFrame::Data(d) => CanFrame::new(d.id(), d.data()),
             _ => None,
