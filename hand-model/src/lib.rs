@@ -12,8 +12,9 @@
 //! - [`emg`]: the signal model: 10 muscle sources (flexor and extensor per finger), cross-talk
 //!   into 12 channels, mains, DC offset and drift, noise floor, 12-bit ADC.
 //! - [`patient`]: intents per finger, scripts (rest, holds, ramps, gestures), the calibration
-//!   protocol with its trials ([`patient::Trial`], the decoder's type), and the closed-loop
-//!   user.
+//!   protocol with its trials ([`patient::Trial`], the decoder's type), the closed-loop user,
+//!   and the cued patient ([`patient::CuedPatient`]) who follows CALIBRATION_CUE frames from
+//!   the bus as a person follows `handctl calibrate`'s cues.
 //! - [`finger`]: one finger's mechanics and control law.
 //! - [`nodes`]: the bus nodes, each stepped by `poll(now_us, &mut bus)`: amplifier, motor
 //!   controllers, fault injector, and a setpoint source standing in for the daemon in tests.

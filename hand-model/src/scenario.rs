@@ -176,6 +176,42 @@ pub struct ScenarioRun {
 impl ScenarioRun {
     /// The cued scenario with these settings (e.g. a [`CuedConfig::weak_trial`]): runs
     /// [`CUED_DURATION_US`], no trials of its own (the cues' sender knows them).
+    ///
+    /// In memory on the virtual clock, as `handctl calibrate`'s tests drive it: the world on a
+    /// [`crate::MemBus`], the tool on another endpoint of it.
+    ///
+    /// ```
+    /// use hand_dbc::e2e::E2eProtector;
+    /// use hand_dbc::messages::{CalibrationCue, CueKind, CuePhase};
+    /// use hand_model::patient::CuedConfig;
+    /// use hand_model::scenario::ScenarioRun;
+    /// use hand_model::world::{PatientMode, World, WorldConfig};
+    /// use hand_model::{MemBus, VirtualClock};
+    ///
+    /// let clock = VirtualClock::new();
+    /// let bus = MemBus::with_clock(clock.clone());
+    /// let cued = CuedConfig { seed: 1, weak_trial: Some(3), ..CuedConfig::default() };
+    /// let patient = ScenarioRun::cued(cued)?.patient; // or Scenario::Cued.build(seed)?
+    /// let mut world = World::try_new(WorldConfig::default(), patient, || {
+    ///     Ok::<_, std::convert::Infallible>(bus.endpoint())
+    /// })?;
+    /// let mut tool = bus.endpoint(); // the calibrating tool
+    /// let mut protect = E2eProtector::new(CalibrationCue::E2E);
+    /// // Trial 3, attempt 0: whole-hand (5) extension, the weak one.
+    /// let hold = CalibrationCue::new(CuePhase::Hold, 3, 5, CueKind::Extension, 0, 0, 5.0, 100)?;
+    /// for t in (0..=1_000_000u64).step_by(1000) {
+    ///     clock.set_us(t);
+    ///     if t % 100_000 == 0 {
+    ///         tool.send(&protect.protect_message(&hold)?)?; // 10 Hz
+    ///     }
+    ///     world.step(t); // the patient reads the cue; EMG and finger status go out
+    /// }
+    /// let level = -world.intent().0[2];
+    /// assert!((0.47..=0.5).contains(&level), "{level}"); // half effort, once
+    /// let PatientMode::Cued(p) = world.patient() else { unreachable!() };
+    /// assert_eq!((p.stats().accepted, p.stats().weak_holds), (11, 1));
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
     pub fn cued(cfg: CuedConfig) -> Result<Self, SimError> {
         Ok(Self {
             scenario: Scenario::Cued,

@@ -138,17 +138,8 @@ fn calibration_world_puts_contractions_on_the_bus() {
     let mut w = world(&h, 1, run.patient);
     h.run(trial.end_us, |t| w.step(t));
     // Channel 2 (over the index flexor) during the trial vs the rest before the first ramp.
-    let emg2 = |from: u64, to: u64| -> f64 {
-        let v: Vec<f64> = h
-            .with_id(EmgSamplesG0::ID)
-            .iter()
-            .filter(|(t, _)| (from..to).contains(t))
-            .map(|(_, f)| EmgSamplesG0::decode(f.data()).expect("valid").emg2())
-            .collect();
-        common::rms_ac(&v)
-    };
-    let rest = emg2(0, 300_000);
-    let active = emg2(trial.start_us, trial.end_us);
+    let rest = emg2_rms(&h, 0, 300_000);
+    let active = emg2_rms(&h, trial.start_us, trial.end_us);
     assert!(
         active > 10.0 * rest,
         "contraction RMS {active} µV vs rest {rest} µV"
@@ -236,36 +227,22 @@ const CUES: [Step; 10] = [
 /// Where the cues stop.
 const CUES_STOP_US: u64 = 14_000_000;
 
-#[test]
-fn cued_patient_follows_the_cues_on_the_bus_after_a_reaction_delay() {
-    let mut h = Harness::new();
-    let cfg = CuedConfig {
-        seed: 5,
-        weak_trial: Some(2),
-        ..CuedConfig::default()
-    };
-    let patient = ScenarioRun::cued(cfg).expect("valid").patient;
-    let mut w = world(&h, 5, patient);
+/// Sends `CUES` at 10 Hz from a tool endpoint until `CUES_STOP_US`, plus one corrupted HOLD
+/// at 0.5 s, steps the world to 16.5 s and returns its intent every ms and the frames sent
+/// (valid, corrupted).
+fn drive_cues(h: &mut Harness, w: &mut World<MemEndpoint>) -> (Vec<Intent>, u64, u64) {
     let mut tool = h.bus.endpoint();
     let mut protector = E2eProtector::new(CalibrationCue::E2E);
     let mut intents: Vec<Intent> = Vec::new();
     let (mut sent, mut sent_bad) = (0, 0);
     h.run(16_500_000, |t| {
-        let cur = CUES.iter().rev().find(|c| c.start_us <= t).expect("from 0");
+        let c = CUES.iter().rev().find(|c| c.start_us <= t).expect("from 0");
         if t < CUES_STOP_US && t % 100_000 == 0 {
-            let cue = CalibrationCue::new(
-                cur.phase,
-                cur.trial,
-                cur.finger,
-                cur.kind,
-                0,
-                cur.attempt,
-                1.0,
-                100,
-            )
-            .expect("in range");
-            tool.send(&protector.protect_message(&cue).expect("profile"))
-                .expect("sent");
+            let cue =
+                CalibrationCue::new(c.phase, c.trial, c.finger, c.kind, 0, c.attempt, 1.0, 100)
+                    .expect("in range");
+            let frame = protector.protect_message(&cue).expect("profile");
+            tool.send(&frame).expect("sent");
             sent += 1;
         }
         if t == 500_000 {
@@ -280,7 +257,87 @@ fn cued_patient_follows_the_cues_on_the_bus_after_a_reaction_delay() {
         w.step(t);
         intents.push(w.intent());
     });
+    (intents, sent, sent_bad)
+}
+
+/// One cued hold: from `start_us` (the HOLD cue) to `end_us` (the RELAX cue, or the cue
+/// timeout), these fingers (bit f) at `sign` · a level in `level`.
+struct Hold {
+    start_us: u64,
+    end_us: u64,
+    fingers: u8,
+    sign: f64,
+    level: (f64, f64),
+}
+
+/// The intent (sampled every ms) follows `hold`: first move 250..450 ms after the cue, the
+/// plateau 650 ms after it on the cued fingers only, still held 249 ms after the end, at rest
+/// 950 ms after it.
+fn check_hold(intents: &[Intent], hold: &Hold) {
     let at = |t_us: u64| intents[(t_us / 1000) as usize];
+    let Hold {
+        start_us: start,
+        end_us: end,
+        ..
+    } = *hold;
+    let first = (start..end)
+        .step_by(1000)
+        .find(|&t| at(t) != Intent::REST)
+        .expect("the patient reacts");
+    let delay = first - start;
+    assert!(
+        (250_000..=451_000).contains(&delay),
+        "hold at {start} µs: first move after {delay} µs"
+    );
+    for t in (start + 651_000..end).step_by(1000) {
+        for f in 0..5 {
+            let x = at(t).0[f];
+            if hold.fingers & (1 << f) == 0 {
+                assert_eq!(x, 0.0, "hold at {start} µs: finger {f} moves at {t} µs");
+            } else {
+                let (lo, hi) = hold.level;
+                let y = hold.sign * x;
+                assert!(
+                    (lo..=hi).contains(&y),
+                    "hold at {start} µs, finger {f} at {t} µs: {x}"
+                );
+            }
+        }
+    }
+    assert!(
+        at(end + 249_000) != Intent::REST,
+        "hold at {start} µs let go too early"
+    );
+    assert!(
+        (end + 951_000..end + 1_500_000)
+            .step_by(1000)
+            .all(|t| at(t) == Intent::REST),
+        "hold at {start} µs: not at rest 950 ms after the relax"
+    );
+}
+
+/// AC RMS of EMG channel 2 (over the index flexor) received in `from..to`, µV.
+fn emg2_rms(h: &Harness, from: u64, to: u64) -> f64 {
+    let v: Vec<f64> = h
+        .with_id(EmgSamplesG0::ID)
+        .iter()
+        .filter(|(t, _)| (from..to).contains(t))
+        .map(|(_, f)| EmgSamplesG0::decode(f.data()).expect("valid").emg2())
+        .collect();
+    common::rms_ac(&v)
+}
+
+#[test]
+fn cued_patient_follows_the_cues_on_the_bus_after_a_reaction_delay() {
+    let mut h = Harness::new();
+    let cfg = CuedConfig {
+        seed: 5,
+        weak_trial: Some(2),
+        ..CuedConfig::default()
+    };
+    let patient = ScenarioRun::cued(cfg).expect("valid").patient;
+    let mut w = world(&h, 5, patient);
+    let (intents, sent, sent_bad) = drive_cues(&mut h, &mut w);
     let PatientMode::Cued(p) = w.patient() else {
         panic!("cued scenario");
     };
@@ -293,72 +350,34 @@ fn cued_patient_follows_the_cues_on_the_bus_after_a_reaction_delay() {
     assert_eq!((st.weak_holds, st.timeouts), (1, 1), "{st:?}");
 
     // Before the first HOLD (and despite the corrupted one) the hand rests.
-    assert!((0..1_750_000).step_by(1000).all(|t| at(t) == Intent::REST));
-    // Each HOLD: (start, end, fingers cued, sign, level range).
-    let holds = [
-        (1_500_000, 3_500_000, 0b00010, 1.0, (0.95, 1.0)),
-        (5_000_000, 7_000_000, 0b11111, -1.0, (0.95, 1.0)),
-        (8_500_000, 10_500_000, 0b00010, 1.0, (0.475, 0.5)),
-        // The last cue goes out at 13.9 s: the timeout is 1 s later.
-        (12_000_000, 14_900_000, 0b00010, 1.0, (0.95, 1.0)),
-    ];
-    for (start, end, fingers, sign, (lo, hi)) in holds {
-        let first = (start..end)
-            .step_by(1000)
-            .find(|&t| at(t) != Intent::REST)
-            .expect("the patient reacts");
-        let delay = first - start;
-        assert!(
-            (250_000..=451_000).contains(&delay),
-            "hold at {start} µs: first move after {delay} µs"
-        );
-        // The plateau: from 650 ms after the cue (reaction + rise) to the end of the hold.
-        for t in (start + 651_000..end).step_by(1000) {
-            for f in 0..5 {
-                let x = at(t).0[f];
-                if fingers & (1 << f) != 0 {
-                    assert!(
-                        (lo..=hi).contains(&(sign * x)),
-                        "hold at {start} µs, finger {f} at {t} µs: {x}"
-                    );
-                } else {
-                    assert_eq!(x, 0.0, "hold at {start} µs: finger {f} moves at {t} µs");
-                }
-            }
-        }
-        // Let go: still holding for the reaction delay, at rest 950 ms after the cue
-        // (for the last hold, 1 s after the last cue: the timeout).
-        assert!(
-            at(end + 249_000) != Intent::REST,
-            "hold at {start} µs let go too early"
-        );
-        assert!(
-            (end + 951_000..end + 1_500_000)
-                .step_by(1000)
-                .all(|t| at(t) == Intent::REST),
-            "hold at {start} µs: not at rest 950 ms after the relax"
-        );
+    assert!(intents[..1750].iter().all(|i| *i == Intent::REST));
+    let hold = |start_us, end_us, fingers, sign, level| Hold {
+        start_us,
+        end_us,
+        fingers,
+        sign,
+        level,
+    };
+    for h in [
+        hold(1_500_000, 3_500_000, 0b00010, 1.0, (0.95, 1.0)),
+        hold(5_000_000, 7_000_000, 0b11111, -1.0, (0.95, 1.0)),
+        // The weak first attempt of trial 2, then its repeat, whose last cue goes out at
+        // 13.9 s: 1 s later the patient takes the cues as gone.
+        hold(8_500_000, 10_500_000, 0b00010, 1.0, (0.475, 0.5)),
+        hold(12_000_000, 14_900_000, 0b00010, 1.0, (0.95, 1.0)),
+    ] {
+        check_hold(&intents, &h);
     }
 
-    // The amplifier shows it: the index flexor's channel (2) during the weak hold is about
-    // half of the full one, and both far above rest.
-    let emg2 = |from: u64, to: u64| -> f64 {
-        let v: Vec<f64> = h
-            .with_id(EmgSamplesG0::ID)
-            .iter()
-            .filter(|(t, _)| (from..to).contains(t))
-            .map(|(_, f)| EmgSamplesG0::decode(f.data()).expect("valid").emg2())
-            .collect();
-        common::rms_ac(&v)
-    };
-    let rest = emg2(200_000, 1_400_000);
-    let full = emg2(2_200_000, 3_500_000);
-    let weak = emg2(9_200_000, 10_500_000);
-    let repeat = emg2(12_700_000, 14_000_000);
+    // The amplifier shows it: the index flexor's channel during the weak hold is about half
+    // of the full one (measured 0.43 with seed 5), and both far above rest.
+    let rest = emg2_rms(&h, 200_000, 1_400_000);
+    let full = emg2_rms(&h, 2_200_000, 3_500_000);
+    let weak = emg2_rms(&h, 9_200_000, 10_500_000);
+    let repeat = emg2_rms(&h, 12_700_000, 14_000_000);
     let ratio = weak / full;
-    eprintln!("EMG ch2 RMS: rest {rest:.1} µV, full {full:.1}, weak {weak:.1}, repeat {repeat:.1}; weak/full {ratio:.3}");
     assert!(full > 10.0 * rest, "full {full} µV vs rest {rest} µV");
-    assert!((0.4..0.65).contains(&ratio), "weak/full EMG RMS {ratio}");
+    assert!((0.35..0.65).contains(&ratio), "weak/full EMG RMS {ratio}");
     assert!(
         (repeat / full - 1.0).abs() < 0.15,
         "repeat {repeat} µV vs full {full} µV"
