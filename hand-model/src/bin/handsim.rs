@@ -50,7 +50,8 @@ struct Args {
     /// Run for this many seconds instead of the scenario's length.
     #[arg(long)]
     duration: Option<f64>,
-    /// Seed of the amplifier's noise and the patient's motor noise.
+    /// Seed of the amplifier's noise, the patient's motor noise and the cued patient's
+    /// reaction delays.
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// Mains frequency, 50 or 60 Hz.
