@@ -114,3 +114,65 @@ impl Command {
         }))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use decoder::dsp::ChainConfig;
+    use decoder::model::{
+        AnyModel, ModelKind, ModelSpec, Normalizer, TrainedModel, TrainingSummary,
+    };
+
+    use super::*;
+    use crate::engine::EngineSettings;
+    use crate::safety::DaemonState;
+
+    fn predictor() -> Predictor {
+        let chain = ChainConfig::default();
+        let n_in = 8 * chain.channels;
+        let spec = ModelSpec::default();
+        let model = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, 3).expect("model");
+        let norm = Normalizer::from_scales(vec![100.0; n_in]).expect("normalizer");
+        let summary = TrainingSummary::untrained(ModelKind::ResDd);
+        TrainedModel::new(model, spec, norm, chain, summary)
+            .expect("trained model")
+            .predictor()
+    }
+
+    #[test]
+    fn without_a_model_the_engine_is_safe_and_refuses_arm_until_a_swap() {
+        let chain = ChainConfig::default().validate().expect("chain");
+        let mut e = Engine::without_model(&chain, EngineSettings::default(), 0);
+        e.validated(0);
+        assert_eq!(e.state(), DaemonState::Safe);
+        assert!(e.faults().contains(Fault::NoModel));
+        assert_eq!(e.command(10, Command::Arm), Err(ArmError::NoModel));
+        e.command(20, Command::Calibrating).expect("hold");
+        let (tx, rx) = std::sync::mpsc::sync_channel(1);
+        e.command(30, Command::swap(predictor(), 0xabcd, tx))
+            .expect("swap");
+        let old = rx.try_recv().expect("the replaced model comes back");
+        assert!(old.swapped && old.predictor.is_none() && old.model_id == 0);
+        assert_eq!((e.model_id(), e.hold()), (0xabcd, Hold::Deployed));
+        e.command(40, Command::Arm).expect("arm after the swap");
+        assert!(e.faults().is_empty() && e.hold() == Hold::Free);
+    }
+
+    #[test]
+    fn a_predictor_that_does_not_fit_the_chain_comes_back_unswapped() {
+        let chain = ChainConfig {
+            channels: 10,
+            ..ChainConfig::default()
+        };
+        let mut e = Engine::without_model(
+            &chain.validate().expect("chain"),
+            EngineSettings::default(),
+            0,
+        );
+        let (tx, rx) = std::sync::mpsc::sync_channel(1);
+        e.command(0, Command::swap(predictor(), 7, tx))
+            .expect("swap");
+        let back = rx.try_recv().expect("sent back");
+        assert!(!back.swapped && back.model_id == 7 && back.predictor.is_some());
+        assert!(!e.has_model());
+    }
+}
