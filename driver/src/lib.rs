@@ -12,10 +12,12 @@ pub mod control;
 pub mod daemon;
 #[cfg(feature = "sim")]
 pub mod demo;
+pub mod deploy;
 pub mod engine;
 pub mod live;
 #[cfg(feature = "sim")]
 pub mod mem_transport;
+pub mod model_service;
 pub mod protocol;
 pub mod rt;
 pub mod safety;

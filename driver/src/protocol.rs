@@ -35,6 +35,21 @@ pub enum Request {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         every_ms: Option<u64>,
     },
+    /// A calibration begins: hold the hand in safe stop until a model is deployed (or rolled
+    /// back) and an explicit `arm` follows.
+    Calibrating,
+    /// Check the model file at `path` off the control loop and swap it in at a tick boundary;
+    /// the model it replaces is kept for `rollback`. Refused with the reason, nothing
+    /// changed, for a bad model.
+    Deploy {
+        /// The model file, an absolute path on the daemon's machine.
+        path: String,
+        /// Deploy a model whose file records no verification, or a failed (or forced) one.
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        force: bool,
+    },
+    /// Swap back the model the last deploy replaced.
+    Rollback,
 }
 
 /// A subscription's period when the request names none, ms.
@@ -212,7 +227,12 @@ impl Request {
     /// The fields this command takes besides `cmd`.
     fn fields(&self) -> &'static [&'static str] {
         match self {
-            Request::Status | Request::Arm | Request::Stop => &[],
+            Request::Status
+            | Request::Arm
+            | Request::Stop
+            | Request::Calibrating
+            | Request::Rollback => &[],
+            Request::Deploy { .. } => &["path", "force"],
             Request::Tune { .. } => &["finger", "kf", "kalpha"],
             Request::Subscribe { .. } => &["every_ms"],
         }
@@ -237,6 +257,16 @@ mod tests {
                 finger: "index".into(),
                 kf: Some(0.8),
                 kalpha: None,
+            },
+            Request::Calibrating,
+            Request::Rollback,
+            Request::Deploy {
+                path: "/m.hsm".into(),
+                force: false,
+            },
+            Request::Deploy {
+                path: "/m.hsm".into(),
+                force: true,
             },
         ] {
             let line = serde_json::to_string(&r).unwrap();
@@ -306,6 +336,38 @@ mod tests {
                 e.contains(&format!("unknown field `{field}`")),
                 "{line}: {e}"
             );
+        }
+        // The requests of issue 14, exactly as the calibrating tool sends them.
+        assert_eq!(
+            parse_request(r#"{"cmd":"deploy","path":"/abs/model.hsm"}"#).unwrap(),
+            Request::Deploy {
+                path: "/abs/model.hsm".into(),
+                force: false
+            }
+        );
+        assert_eq!(
+            parse_request(r#"{"cmd":"calibrating"}"#).unwrap(),
+            Request::Calibrating
+        );
+        for (line, want) in [
+            (r#"{"cmd":"deploy","path":7}"#, "field `path`"),
+            (
+                r#"{"cmd":"deploy","path":"/m","force":"yes"}"#,
+                "field `force`",
+            ),
+            (r#"{"cmd":"deploy"}"#, "missing field `path`"),
+            (
+                r#"{"cmd":"deploy","path":"/m","model":1}"#,
+                "unknown field `model`",
+            ),
+            (r#"{"cmd":"rollback","path":"/m"}"#, "unknown field `path`"),
+            (
+                r#"{"cmd":"calibrating","force":true}"#,
+                "unknown field `force`",
+            ),
+        ] {
+            let e = parse_request(line).unwrap_err();
+            assert!(e.contains(want), "{line}: {e}");
         }
         assert!(parse_request_bytes(b"{\"cmd\":\"st\xffatus\"}")
             .unwrap_err()

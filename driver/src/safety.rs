@@ -73,11 +73,16 @@ pub enum Fault {
     ModelError,
     /// A technician asked for a stop.
     StopRequested,
+    /// A calibration is under way (`handctl calibrate`, or the `calibrating` request): the hand
+    /// is held in safe stop until a model is deployed (or rolled back) and then armed.
+    Calibrating,
+    /// The daemon started without a model file: nothing drives the hand until `handctl deploy`.
+    NoModel,
 }
 
 impl Fault {
     /// All faults, in bit order.
-    pub const ALL: [Fault; 11] = [
+    pub const ALL: [Fault; 13] = [
         Fault::EmgSilence,
         Fault::E2eError,
         Fault::InvalidWindow,
@@ -89,6 +94,8 @@ impl Fault {
         Fault::RepeatedE2e,
         Fault::ModelError,
         Fault::StopRequested,
+        Fault::Calibrating,
+        Fault::NoModel,
     ];
 
     /// Whether the fault stays until `handctl arm`.
@@ -101,6 +108,8 @@ impl Fault {
                 | Fault::RepeatedE2e
                 | Fault::ModelError
                 | Fault::StopRequested
+                | Fault::Calibrating
+                | Fault::NoModel
         )
     }
 
@@ -123,6 +132,8 @@ impl Fault {
             Fault::RepeatedE2e => "repeated_e2e",
             Fault::ModelError => "model_error",
             Fault::StopRequested => "stop_requested",
+            Fault::Calibrating => "calibrating",
+            Fault::NoModel => "no_model",
         }
     }
 }
@@ -234,6 +245,12 @@ pub enum ArmError {
     /// Arming before validation makes no sense.
     #[error("the daemon is still booting")]
     Booting,
+    /// A calibration holds the hand until a model is deployed or rolled back.
+    #[error("calibrating: the hand stays held until a model is deployed (`handctl deploy MODEL`) or rolled back (`handctl rollback`); then arm")]
+    Calibrating,
+    /// No model runs yet.
+    #[error("no model: deploy one first (`handctl deploy MODEL`)")]
+    NoModel,
 }
 
 /// The state machine.

@@ -8,10 +8,12 @@
 use std::path::PathBuf;
 use std::sync::mpsc::SyncSender;
 
+use decoder::dsp::ChainConfig;
+
 use crate::config::Config;
 use crate::control::Peer;
 use crate::daemon::SharedSnapshot;
-use crate::engine::Command;
+use crate::engine::{Command, Hold, ModelSwap};
 use crate::protocol::{FingerStatus, ModelStatus, Reply, Request, Status};
 use crate::tuning::{commit_tune, plan_tune, user_name};
 use crate::units::{FINGER_NAMES, N_FINGERS};
@@ -22,11 +24,19 @@ pub const COMMAND_QUEUE: usize = 16;
 
 /// Handles control requests for a running loop.
 pub struct ControlHandler {
-    config: Config,
-    config_path: PathBuf,
+    pub(crate) config: Config,
+    pub(crate) config_path: PathBuf,
     snapshot: SharedSnapshot,
     commands: SyncSender<Command>,
-    model: Option<ModelStatus>,
+    pub(crate) model: Option<ModelStatus>,
+    /// The chain the loop runs: a deployed model must have the same.
+    pub(crate) chain: ChainConfig,
+    /// The model the last deploy or rollback replaced, with its status, for `rollback`.
+    pub(crate) previous: Option<(Box<ModelSwap>, ModelStatus)>,
+    /// The calibrating hold, as the loop has it (every change goes through here).
+    pub(crate) hold: Hold,
+    /// Whether the loop runs without a model (until a deploy).
+    pub(crate) no_model: bool,
 }
 
 impl ControlHandler {
@@ -38,13 +48,34 @@ impl ControlHandler {
         snapshot: SharedSnapshot,
         commands: SyncSender<Command>,
     ) -> Self {
+        let chain = ChainConfig {
+            mains_hz: config.mains_hz,
+            ..ChainConfig::default()
+        };
         Self {
             config,
             config_path,
             snapshot,
             commands,
             model: None,
+            chain,
+            previous: None,
+            hold: Hold::Free,
+            no_model: false,
         }
+    }
+
+    /// The handler, for a loop running the chain `chain` (a deployed model must match it; the
+    /// default chain at the config's mains frequency otherwise).
+    pub fn with_chain(mut self, chain: ChainConfig) -> Self {
+        self.chain = chain;
+        self
+    }
+
+    /// The handler, for a loop started without a model: `arm` is refused until a deploy.
+    pub fn without_model(mut self) -> Self {
+        self.no_model = true;
+        self
     }
 
     /// The handler, telling `status` which model runs.
@@ -83,7 +114,7 @@ impl ControlHandler {
 
     /// Hands `cmd` to the loop, waiting while its queue is full (a tick or two at most: the
     /// loop takes several per tick); fails only when the loop is gone.
-    fn send(&self, cmd: Command) -> Result<(), Box<Reply>> {
+    pub(crate) fn send(&self, cmd: Command) -> Result<(), Box<Reply>> {
         self.commands.send(cmd).map_err(|_| {
             Box::new(Reply::Refused {
                 reason: "the control loop is not running; nothing changed".into(),
@@ -100,16 +131,10 @@ impl ControlHandler {
                 status: Some(self.status()),
             },
             Request::Tune { finger, kf, kalpha } => self.tune(&finger, kf, kalpha, &user),
-            Request::Arm => match self.send(Command::Arm) {
-                Ok(()) => {
-                    tracing::warn!(user, "armed by a technician");
-                    Reply::Ok {
-                        message: "armed: latched faults cleared; the hand moves after 500 ms of good signal".into(),
-                        status: None,
-                    }
-                }
-                Err(r) => *r,
-            },
+            Request::Calibrating => self.calibrating(peer, &user),
+            Request::Deploy { path, force } => self.deploy(&path, force, peer, &user),
+            Request::Rollback => self.rollback(peer, &user),
+            Request::Arm => self.arm(&user),
             Request::Subscribe { .. } => Reply::Refused {
                 reason: "subscribe is served by the control socket, not by this handler".into(),
             },
@@ -123,6 +148,33 @@ impl ControlHandler {
                 }
                 Err(r) => *r,
             },
+        }
+    }
+
+    /// `arm`, refused while calibrating (until a deploy or rollback) and without a model.
+    fn arm(&mut self, user: &str) -> Reply {
+        let refused = match (self.hold, self.no_model) {
+            (Hold::Calibrating, _) => Some(crate::safety::ArmError::Calibrating),
+            (_, true) => Some(crate::safety::ArmError::NoModel),
+            _ => None,
+        };
+        if let Some(e) = refused {
+            return Reply::Refused {
+                reason: e.to_string(),
+            };
+        }
+        match self.send(Command::Arm) {
+            Ok(()) => {
+                self.hold = Hold::Free;
+                tracing::warn!(user, "armed by a technician");
+                Reply::Ok {
+                    message:
+                        "armed: latched faults cleared; the hand moves after 500 ms of good signal"
+                            .into(),
+                    status: None,
+                }
+            }
+            Err(r) => *r,
         }
     }
 

@@ -72,7 +72,13 @@ pub fn load_model(path: &Path, mains_hz: u32) -> Result<LoadedModel, StartupErro
             source: e,
         },
     })?;
-    let model = TrainedModel::from_bytes(&bytes, None).map_err(|source| StartupError::Model {
+    check_model(path, &bytes, mains_hz)
+}
+
+/// Parse the model file's `bytes` (read from `path`) and check that its chain fits the bus and
+/// `mains_hz`, as [`load_model`] does.
+pub fn check_model(path: &Path, bytes: &[u8], mains_hz: u32) -> Result<LoadedModel, StartupError> {
+    let model = TrainedModel::from_bytes(bytes, None).map_err(|source| StartupError::Model {
         path: path.to_owned(),
         source,
     })?;
@@ -106,7 +112,7 @@ pub fn load_model(path: &Path, mains_hz: u32) -> Result<LoadedModel, StartupErro
     Ok(LoadedModel {
         model,
         chain,
-        model_id: fingerprint(&bytes),
+        model_id: fingerprint(bytes),
     })
 }
 

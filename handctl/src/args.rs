@@ -44,6 +44,11 @@ pub enum Command {
     Arm(DaemonOpts),
     /// Safe-stop every finger until `handctl arm`.
     Stop(DaemonOpts),
+    /// Swap a model into the running daemon at a tick boundary, without a restart (checked
+    /// first: file, shape, chain, verification); the config is updated to name it.
+    Deploy(DeployArgs),
+    /// Swap back the model the last deploy (or rollback) replaced.
+    Rollback(DaemonOpts),
     /// The live view of the hand: EMG per channel, fingers, the daemon, a plot; from the
     /// running daemon (default), the bus (--iface, no daemon needed) or a candump log (--log).
     Monitor(MonitorArgs),
@@ -88,6 +93,18 @@ pub struct TuneArgs {
     /// New acceleration gain kα, rad/s² per label unit (0 to 50).
     #[arg(long)]
     pub kalpha: Option<f64>,
+    #[command(flatten)]
+    pub daemon: DaemonOpts,
+}
+
+/// `handctl deploy`.
+#[derive(Debug, Args)]
+pub struct DeployArgs {
+    /// The model file (`handctl train` or `handctl calibrate` wrote it).
+    pub model: PathBuf,
+    /// Deploy a model whose file records no verification, or a failed one.
+    #[arg(long)]
+    pub force: bool,
     #[command(flatten)]
     pub daemon: DaemonOpts,
 }

@@ -28,12 +28,12 @@ pub fn socket_of(o: &DaemonOpts) -> Result<PathBuf, CliError> {
     }
 }
 
-fn ask(o: &DaemonOpts, req: &Request) -> Result<Reply, CliError> {
+pub(crate) fn ask(o: &DaemonOpts, req: &Request) -> Result<Reply, CliError> {
     let socket = socket_of(o)?;
     Ok(request(&socket, req)?)
 }
 
-fn done(reply: Reply) -> Result<Option<Status>, CliError> {
+pub(crate) fn done(reply: Reply) -> Result<Option<Status>, CliError> {
     match reply {
         Reply::Ok { message, status } => {
             if status.is_none() {

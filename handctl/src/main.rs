@@ -15,6 +15,7 @@ mod daemon;
 mod decode;
 #[cfg(feature = "sim")]
 mod demo;
+mod deploy;
 mod error;
 mod eval;
 mod import;
@@ -48,6 +49,8 @@ fn main() -> ExitCode {
         Command::Tune(a) => daemon::tune(a),
         Command::Arm(o) => daemon::arm(o),
         Command::Stop(o) => daemon::stop(o),
+        Command::Deploy(a) => deploy::deploy(a),
+        Command::Rollback(o) => deploy::rollback(o),
         Command::Monitor(a) => monitor::run(a),
         Command::Record(a) => record::run(a),
         Command::Demo(a) => run_demo(a),

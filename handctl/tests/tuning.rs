@@ -137,3 +137,269 @@ fn tune_changes_the_force_by_the_ratio_within_two_ticks_and_persists() {
     assert_eq!(status.fingers[1].kf, 5.0);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A ResDD for the bus's 12 channels with random weights (`seed`), `chain` and a passing
+/// verification record, saved to `path`; returns its bytes.
+fn saved_model(path: &std::path::Path, chain: decoder::dsp::ChainConfig, seed: u64) -> Vec<u8> {
+    use decoder::model::verify::{Method, VerificationRecord};
+    use decoder::model::{
+        AnyModel, ModelKind, ModelSpec, Normalizer, TrainedModel, TrainingSummary,
+    };
+    let n_in = 8 * chain.channels;
+    let spec = ModelSpec::default();
+    let model = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, seed).unwrap();
+    let norm = Normalizer::from_scales(vec![100.0; n_in]).unwrap();
+    let summary = TrainingSummary::untrained(ModelKind::ResDd);
+    let record = VerificationRecord {
+        method: Method::Exact,
+        tolerance: 0.01,
+        rays: 0,
+        reversing: 0,
+        worst: None,
+        forced: false,
+    };
+    TrainedModel::new(model, spec, norm, chain, summary)
+        .unwrap()
+        .with_verification(record)
+        .unwrap()
+        .save(path)
+        .unwrap();
+    std::fs::read(path).unwrap()
+}
+
+/// Runs `handctl ARGS` while the loop ticks on (a deploy waits for its tick); returns whether
+/// it succeeded and what it printed (stdout, then stderr).
+fn handctl_while_ticking(rig: &mut Rig, args: &[&str]) -> (bool, String) {
+    let mut child = Command::new(env!("CARGO_BIN_EXE_handctl"))
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut t = rig.clock_now();
+    while child.try_wait().unwrap().is_none() {
+        t += 1000;
+        rig.run_until(t);
+        std::thread::sleep(std::time::Duration::from_micros(200));
+    }
+    let out = child.wait_with_output().unwrap();
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out.status.success(), text)
+}
+
+/// HAND_HEARTBEAT's model ids seen from `from_us` on, with their times.
+fn heartbeat_ids(rig: &Rig, from_us: u64) -> Vec<(u64, u32)> {
+    use hand_dbc::messages::HandHeartbeat;
+    rig.seen
+        .iter()
+        .filter(|(t, f)| *t >= from_us && f.raw_id() == HandHeartbeat::ID)
+        .filter_map(|(t, f)| Some((*t, HandHeartbeat::decode(f.data()).ok()?.model_id())))
+        .collect()
+}
+
+/// Issue 14 on the in-memory bus: the calibrating hold (safe stops only, `arm` refused until a
+/// deploy, then `arm` moves the hand again), `handctl deploy` of a corrupted and of a
+/// mismatched file refused with the reason while the old model keeps driving, a good model
+/// swapped in at a tick boundary with no tick missed (HAND_HEARTBEAT's id changes, the config
+/// names the installed copy), and `handctl rollback` bringing the previous id back; each
+/// action audited with uid and pid.
+#[test]
+fn calibrating_hold_deploy_refusals_swap_and_rollback() {
+    use driver::control::request;
+    use driver::engine::Command as LoopCommand;
+    use driver::protocol::{Reply, Request};
+    use driver::startup::fingerprint;
+    use hand_dbc::messages::FingerMode;
+
+    let dir = std::env::temp_dir().join(format!("handd-deploy-e2e-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let config_path = dir.join("handd.toml");
+    let mut config = Config::default();
+    config.control.socket = dir.join("ctl.sock");
+    config.control.group = None;
+    config.control.audit_log = dir.join("audit.log");
+    config.model = dir.join("model.hsm");
+    config.save_atomic(&config_path).unwrap();
+    let chain = decoder::dsp::ChainConfig::default();
+    let id_a = fingerprint(&saved_model(&config.model, chain.clone(), 7));
+    let good = dir.join("new.hsm");
+    let id_b = fingerprint(&saved_model(&good, chain.clone(), 8));
+    assert_ne!(id_a, id_b);
+    let mut bytes = std::fs::read(&good).unwrap();
+    let mid = bytes.len() / 2;
+    bytes[mid] ^= 0x40;
+    std::fs::write(dir.join("corrupt.hsm"), &bytes).unwrap();
+    let other = decoder::dsp::ChainConfig {
+        window_ms: 250.0,
+        ..chain.clone()
+    };
+    saved_model(&dir.join("other.hsm"), other, 9);
+
+    let mut script = Script::new();
+    script
+        .rest(500_000)
+        .hold(Intent::finger(1, 0.8), 60_000_000);
+    let mut rig = Rig::new(FaultPlan::new(), script);
+    // The loop starts on model A, swapped in as a deploy would.
+    let loaded = driver::startup::load_model(&config.model, 50).unwrap();
+    let (back, _returned) = mpsc::sync_channel(1);
+    rig.runner
+        .engine_mut()
+        .command(0, LoopCommand::swap(loaded.model.predictor(), id_a, back))
+        .unwrap();
+    let (tx, rx) = mpsc::sync_channel(driver::service::COMMAND_QUEUE);
+    rig.runner.set_commands(rx);
+    let mut handler = ControlHandler::new(
+        config.clone(),
+        config_path.clone(),
+        rig.runner.snapshot(),
+        tx,
+    )
+    .with_model(loaded.status(&config.model));
+    let server = ControlServer::bind(&config.control.socket, None).unwrap();
+    std::thread::spawn(move || server.serve(move |req, peer| handler.handle(req, peer)));
+    let sock = config.control.socket.clone();
+    let s = sock.to_str().unwrap();
+
+    rig.run_until(2_000_000);
+    assert!(heartbeat_ids(&rig, 0).iter().all(|h| h.1 == id_a));
+    let ask = |req: Request| request(&sock, &req).unwrap();
+
+    // The hold: safe stops only from the next tick, arm refused.
+    let held_from = rig.clock_now();
+    assert!(matches!(ask(Request::Calibrating), Reply::Ok { .. }));
+    match ask(Request::Arm) {
+        Reply::Refused { reason } => assert!(reason.contains("calibrating"), "{reason}"),
+        r => panic!("arm during the hold: {r:?}"),
+    }
+    rig.run_until(held_from + 1_000_000);
+    let modes_seen = |rig: &Rig, from: u64, to: u64| -> Vec<FingerMode> {
+        rig.setpoints()
+            .iter()
+            .filter(|p| p.0 > from && p.0 <= to)
+            .map(|p| p.2)
+            .collect()
+    };
+    assert!(
+        modes_seen(&rig, 1_000_000, held_from).contains(&FingerMode::Active),
+        "the hand moved before the hold"
+    );
+    match ask(Request::Status) {
+        Reply::Ok {
+            status: Some(st), ..
+        } => {
+            assert!(
+                st.state == "SAFE" && st.faults.contains("calibrating"),
+                "{st:?}"
+            )
+        }
+        r => panic!("status: {r:?}"),
+    }
+
+    // Bad models: refused with the reason, the old id stays on the bus.
+    let (ok, said) = handctl_while_ticking(
+        &mut rig,
+        &[
+            "deploy",
+            dir.join("corrupt.hsm").to_str().unwrap(),
+            "--socket",
+            s,
+        ],
+    );
+    assert!(!ok && said.contains("checksum"), "{said}");
+    let (ok, said) = handctl_while_ticking(
+        &mut rig,
+        &[
+            "deploy",
+            dir.join("other.hsm").to_str().unwrap(),
+            "--socket",
+            s,
+        ],
+    );
+    assert!(
+        !ok && said.contains("window_ms: model 250.0, running 200.0"),
+        "{said}"
+    );
+    let (ok, said) = handctl_while_ticking(
+        &mut rig,
+        &[
+            "deploy",
+            dir.join("absent.hsm").to_str().unwrap(),
+            "--socket",
+            s,
+        ],
+    );
+    assert!(!ok && said.contains("absent.hsm"), "{said}");
+    assert_eq!(Config::load(&config_path).unwrap().model, config.model);
+
+    // The good one: swapped at a tick, the config names its installed copy, still held.
+    let before = rig.runner.engine().counters();
+    let deploy_at = rig.clock_now();
+    let (ok, said) =
+        handctl_while_ticking(&mut rig, &["deploy", good.to_str().unwrap(), "--socket", s]);
+    assert!(ok, "{said}");
+    assert!(said.contains(&format!("{id_b:08x}")), "{said}");
+    rig.run_until(rig.clock_now() + 500_000);
+    let ids = heartbeat_ids(&rig, held_from);
+    let first_b = ids
+        .iter()
+        .position(|h| h.1 == id_b)
+        .expect("the new id on the bus");
+    assert!(
+        ids[..first_b].iter().all(|h| h.1 == id_a) && ids[first_b..].iter().all(|h| h.1 == id_b)
+    );
+    assert!(ids[first_b].0 >= deploy_at);
+    // No tick missed: the setpoints of every 50 ms tick are on the bus across the swap.
+    let ticks: Vec<u64> = rig
+        .setpoints()
+        .iter()
+        .filter(|p| p.1 == 0 && p.0 >= deploy_at)
+        .map(|p| p.0)
+        .collect();
+    assert!(ticks.windows(2).all(|w| w[1] - w[0] == 50_000), "{ticks:?}");
+    let after = rig.runner.engine().counters();
+    assert_eq!(after.deadline_misses, before.deadline_misses);
+    let installed = dir.join(format!("model-{id_b:08x}.hsm"));
+    assert_eq!(Config::load(&config_path).unwrap().model, installed);
+    assert_eq!(fingerprint(&std::fs::read(&installed).unwrap()), id_b);
+    let until = rig.clock_now();
+    assert!(modes_seen(&rig, held_from + 50_000, until)
+        .iter()
+        .all(|m| *m == FingerMode::SafeStop));
+
+    // arm now releases the hand.
+    assert!(
+        matches!(ask(Request::Arm), Reply::Ok { .. }),
+        "arm after the deploy"
+    );
+    rig.run_until(until + 2_000_000);
+    assert!(modes_seen(&rig, until, rig.clock_now()).contains(&FingerMode::Active));
+
+    // rollback: model A's id again, and the config names A's file.
+    let back_at = rig.clock_now();
+    let (ok, said) = handctl_while_ticking(&mut rig, &["rollback", "--socket", s]);
+    assert!(ok, "{said}");
+    rig.run_until(rig.clock_now() + 300_000);
+    assert_eq!(
+        heartbeat_ids(&rig, back_at + 100_000).last().unwrap().1,
+        id_a
+    );
+    assert_eq!(Config::load(&config_path).unwrap().model, config.model);
+    let audit = std::fs::read_to_string(dir.join("audit.log")).unwrap();
+    for want in [
+        "calibrating",
+        &format!("deploy path={}", good.display()),
+        &format!("id={id_b:08x}"),
+        "rollback",
+        "uid=",
+        "pid=",
+    ] {
+        assert!(audit.contains(want), "{want}: {audit}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -10,6 +10,7 @@ use std::sync::{mpsc, Arc};
 use std::time::{Duration, Instant};
 
 use clap::Parser;
+use decoder::dsp::ChainConfig;
 use decoder::model::Model as _;
 use driver::config::{Config, DEFAULT_CONFIG_PATH};
 use driver::control::{ControlServer, LiveFeed};
@@ -19,7 +20,7 @@ use driver::live::ModelInfo;
 use driver::rt::{lock_memory, set_fifo, RtReport};
 use driver::service::{ControlHandler, COMMAND_QUEUE};
 use driver::socketcan_bus::SocketCanTransport;
-use driver::startup::{engine_settings, load_model, remove_stale_temps};
+use driver::startup::{engine_settings, load_model, remove_stale_temps, LoadedModel};
 use hand_clock::{Clock, SystemClock};
 
 /// The handstack daemon.
@@ -84,29 +85,68 @@ fn main() -> ExitCode {
     }
 }
 
-fn run(args: &Args) -> Result<(), String> {
-    let config = Config::load(&args.config).map_err(|e| e.to_string())?;
+/// The model the config names, or None when its file is absent (handd then starts SAFE with
+/// `no_model` latched and waits for `handctl deploy`).
+fn load_configured(config: &Config, check: bool) -> Result<Option<LoadedModel>, String> {
+    if !check && !config.model.exists() {
+        tracing::warn!(
+            model = %config.model.display(),
+            "no model: the hand stays SAFE; handctl deploy MODEL"
+        );
+        return Ok(None);
+    }
     let loaded = load_model(&config.model, config.mains_hz).map_err(|e| e.to_string())?;
     tracing::info!(
-        config = %args.config.display(),
         model = %config.model.display(),
         kind = %loaded.model.model().kind(),
         model_id = format!("{:08x}", loaded.model_id),
-        interface = %config.interface,
-        "config and model validated"
+        "model validated"
     );
     loaded.log_verification(&config.model);
-    let model_status = loaded.status(&config.model);
+    Ok(Some(loaded))
+}
+
+/// The engine for `loaded` (or without a model), and the chain it runs.
+fn build_engine(
+    config: &Config,
+    loaded: Option<&LoadedModel>,
+    now_us: u64,
+) -> (Engine, ChainConfig) {
+    let settings = engine_settings(config, loaded.map_or(0, |l| l.model_id));
+    let (mut engine, chain) = match loaded {
+        Some(l) => (
+            Engine::new(&l.chain, l.model.predictor(), settings, now_us),
+            l.model.chain().clone(),
+        ),
+        None => {
+            let chain = ChainConfig {
+                mains_hz: config.mains_hz,
+                ..ChainConfig::default()
+            };
+            let designed = chain.validate().expect("the default chain is valid");
+            (Engine::without_model(&designed, settings, now_us), chain)
+        }
+    };
+    engine.validated(now_us);
+    (engine, chain)
+}
+
+fn run(args: &Args) -> Result<(), String> {
+    let config = Config::load(&args.config).map_err(|e| e.to_string())?;
+    let loaded = load_configured(&config, args.check)?;
+    tracing::info!(config = %args.config.display(), interface = %config.interface, "config validated");
     if args.check {
-        println!(
-            "config {} and model {} ({}, id {:08x}) are valid; interface {}\nmodel {}",
-            args.config.display(),
-            config.model.display(),
-            loaded.model.model().kind(),
-            loaded.model_id,
-            config.interface,
-            model_status.verification
-        );
+        if let Some(l) = &loaded {
+            println!(
+                "config {} and model {} ({}, id {:08x}) are valid; interface {}\nmodel {}",
+                args.config.display(),
+                config.model.display(),
+                l.model.model().kind(),
+                l.model_id,
+                config.interface,
+                l.status(&config.model).verification
+            );
+        }
         return Ok(());
     }
     // Saves killed midway (a writer's .tmp.PID files) are cleaned up before anything runs.
@@ -124,33 +164,34 @@ fn run(args: &Args) -> Result<(), String> {
     let clock = SystemClock::new();
     let transport =
         SocketCanTransport::open(&config.interface, clock).map_err(|e| format!("bus: {e}"))?;
-    let settings = engine_settings(&config, loaded.model_id);
-    let mut engine = Engine::new(
-        &loaded.chain,
-        loaded.model.predictor(),
-        settings,
-        clock.now_us(),
-    );
-    engine.validated(clock.now_us());
+    let (engine, chain) = build_engine(&config, loaded.as_ref(), clock.now_us());
 
     let (tx, rx) = mpsc::sync_channel(COMMAND_QUEUE);
     let mut runner = Runner::new(engine, transport, clock, config.tick_ms * 1000).with_commands(rx);
     let live = LiveFeed {
         snapshot: runner.snapshot(),
         model: ModelInfo {
-            id: format!("{:08x}", loaded.model_id),
+            id: format!("{:08x}", loaded.as_ref().map_or(0, |l| l.model_id)),
             path: config.model.display().to_string(),
-            kind: loaded.model.model().kind().to_string(),
+            kind: loaded
+                .as_ref()
+                .map_or("none".into(), |l| l.model.model().kind().to_string()),
         },
         tick_us: config.tick_ms * 1000,
-        rest_rms_uv: loaded.model.rest_rms_uv().map(<[f64]>::to_vec),
+        rest_rms_uv: loaded
+            .as_ref()
+            .and_then(|l| l.model.rest_rms_uv().map(<[f64]>::to_vec)),
     };
     let server = ControlServer::bind(&config.control.socket, config.control.group.as_deref())
         .map_err(|e| e.to_string())?
         .with_live(live);
     let mut handler =
         ControlHandler::new(config.clone(), args.config.clone(), runner.snapshot(), tx)
-            .with_model(model_status);
+            .with_chain(chain);
+    handler = match &loaded {
+        Some(l) => handler.with_model(l.status(&config.model)),
+        None => handler.without_model(),
+    };
     std::thread::Builder::new()
         .name("handd-control".into())
         .spawn(move || server.serve(move |req, peer| handler.handle(req, peer)))

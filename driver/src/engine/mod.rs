@@ -17,9 +17,11 @@
 mod epoch;
 mod faults;
 mod rx;
+mod swap;
 mod tx;
 
 pub use epoch::fresh_epoch;
+pub use swap::{Hold, ModelSwap};
 
 use decoder::dsp::ChainSettings;
 use decoder::model::Predictor;
@@ -89,14 +91,18 @@ pub struct Counters {
 }
 
 /// Requests from technicians, applied at the next tick.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone)]
 pub enum Command {
     /// New gains for one finger.
     SetGains(usize, FingerGains),
-    /// Clear latched faults.
+    /// Clear latched faults (refused during the calibrating hold and without a model).
     Arm,
     /// Go to SAFE until armed.
     Stop,
+    /// Begin the calibrating hold (see [`Hold`]).
+    Calibrating,
+    /// Swap in a prepared model (a deploy or a rollback); see [`ModelSwap`].
+    Swap(Box<ModelSwap>),
 }
 
 /// Timing of the ticks, for HAND_DIAG and `handctl status`.
@@ -117,7 +123,8 @@ pub struct Engine {
     settings: EngineSettings,
     emg: rx::EmgIn,
     inputs: rx::Inputs,
-    predictor: Predictor,
+    predictor: Option<Predictor>,
+    hold: Hold,
     /// Samples in when the model last ran.
     samples_used: u64,
     safety: Safety,
@@ -149,6 +156,21 @@ impl Engine {
             chain.n_features(),
             "model inputs must equal the chain's features"
         );
+        Self::build(chain, Some(predictor), settings, now_us)
+    }
+
+    /// An engine with no model yet: once validated it is SAFE with [`Fault::NoModel`] latched,
+    /// sends safe stops, and refuses `arm` until a model is swapped in ([`Command::Swap`]).
+    pub fn without_model(chain: &ChainSettings, settings: EngineSettings, now_us: u64) -> Self {
+        Self::build(chain, None, settings, now_us)
+    }
+
+    fn build(
+        chain: &ChainSettings,
+        predictor: Option<Predictor>,
+        settings: EngineSettings,
+        now_us: u64,
+    ) -> Self {
         assert!(
             chain.n_channels() <= hand_dbc::emg::EMG_CHANNELS,
             "the bus carries {} EMG channels",
@@ -158,6 +180,7 @@ impl Engine {
             emg: rx::EmgIn::new(chain, settings.max_gap_us, now_us),
             inputs: rx::Inputs::new(),
             predictor,
+            hold: Hold::Free,
             samples_used: 0,
             safety: Safety::new(SafetyTiming {
                 recovery_us: settings.recovery_us,
@@ -209,10 +232,13 @@ impl Engine {
         self.epochs.begun()
     }
 
-    /// Config, model and bus are validated: BOOT -> READY.
+    /// Config, model and bus are validated: BOOT -> READY (SAFE at once without a model).
     pub fn validated(&mut self, now_us: u64) {
         let t = self.safety.validated(now_us);
         self.note(t);
+        if self.predictor.is_none() {
+            self.raise(now_us, Fault::NoModel);
+        }
     }
 
     /// Report a fault found outside the engine (bus-off, interface down).
@@ -226,8 +252,10 @@ impl Engine {
         match cmd {
             Command::SetGains(f, g) if f < N_FINGERS => self.settings.gains[f] = g,
             Command::SetGains(..) => {}
-            Command::Arm => self.safety.arm(now_us)?,
+            Command::Arm => self.arm(now_us)?,
             Command::Stop => self.raise(now_us, Fault::StopRequested),
+            Command::Calibrating => self.begin_hold(now_us),
+            Command::Swap(m) => self.swap_model(m),
         }
         Ok(())
     }
@@ -260,11 +288,14 @@ impl Engine {
     /// The model, on the window ending at the newest sample, when samples came in since its
     /// last run: the setpoints never wait for the chain's next step.
     fn run_model(&mut self, now_us: u64, valid: bool) {
+        let Some(predictor) = self.predictor.as_mut() else {
+            return;
+        };
         if !valid || self.emg.samples_in == self.samples_used {
             return;
         }
         self.samples_used = self.emg.samples_in;
-        let y = self.predictor.run(self.emg.chain.features());
+        let y = predictor.run(self.emg.chain.features());
         if y.iter().all(|v| v.is_finite()) {
             self.labels = y;
         } else {

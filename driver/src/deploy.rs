@@ -1,0 +1,179 @@
+//! Deploying a model to the running daemon, off the control loop: the file is read, parsed
+//! (checksum, shapes, finite weights), checked against the bus, the config and the chain the
+//! loop runs, and its recorded verification is checked; then it is installed (copied beside
+//! the config's model path as `model-<id>.hsm`, and the config rewritten atomically to name
+//! it, so a restart runs the deployed model) and handed to the loop, which swaps it in at a
+//! tick boundary ([`crate::engine::ModelSwap`]). Every refusal names the reason; nothing
+//! changes on one.
+
+use std::fs::OpenOptions;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use decoder::dsp::ChainConfig;
+
+use crate::config::Config;
+use crate::control::Peer;
+use crate::startup::{check_model, LoadedModel, StartupError};
+
+/// Why a deploy or a rollback was refused.
+#[derive(Debug, thiserror::Error)]
+pub enum DeployError {
+    /// The path is not absolute (the daemon's working directory is not the technician's).
+    #[error("model path {0:?} is not absolute: give the full path")]
+    NotAbsolute(String),
+    /// Missing file, parse error, or a chain that does not fit the bus or the config.
+    #[error(transparent)]
+    Model(#[from] StartupError),
+    /// The model's chain differs from the chain the loop runs.
+    #[error("model {path}: its signal chain differs from the running one: {fields}; a model with another chain needs handd restarted")]
+    Chain {
+        /// The model file.
+        path: PathBuf,
+        /// Each differing field with both sides.
+        fields: String,
+    },
+    /// The file records no verification, or a failed (possibly forced) one.
+    #[error("model {path}: {verification}; refused (deploy with --force to run it anyway)")]
+    Unverified {
+        /// The model file.
+        path: PathBuf,
+        /// What the file records.
+        verification: String,
+    },
+    /// The model file or the config could not be written.
+    #[error("could not install the model: {0}; nothing changed")]
+    Install(String),
+    /// Nothing to roll back to.
+    #[error("nothing to roll back to: no model was deployed since handd started")]
+    NoPrevious,
+    /// The loop did not take the model.
+    #[error("{0}; nothing changed")]
+    Loop(String),
+}
+
+/// A model checked and ready for the loop, with the file's bytes (to install them).
+pub struct Prepared {
+    /// The model.
+    pub loaded: LoadedModel,
+    /// The file as read.
+    pub bytes: Vec<u8>,
+    /// Where it was read from.
+    pub source: PathBuf,
+}
+
+/// Reads and checks the model at `path` for a loop running `chain` (see the module doc). A
+/// model whose file records no verification, or one that failed, is refused unless `force`.
+pub fn prepare(path: &str, chain: &ChainConfig, force: bool) -> Result<Prepared, DeployError> {
+    let source = PathBuf::from(path);
+    if !source.is_absolute() {
+        return Err(DeployError::NotAbsolute(path.to_owned()));
+    }
+    let bytes = std::fs::read(&source).map_err(|e| StartupError::Model {
+        path: source.clone(),
+        source: decoder::model::FileError::Io {
+            op: "read",
+            path: source.clone(),
+            source: e,
+        },
+    })?;
+    let loaded = check_model(&source, &bytes, chain.mains_hz)?;
+    let fields = chain_differences(loaded.model.chain(), chain);
+    if !fields.is_empty() {
+        return Err(DeployError::Chain {
+            path: source,
+            fields,
+        });
+    }
+    let status = loaded.status(&source);
+    if status.unverified && !force {
+        return Err(DeployError::Unverified {
+            path: source,
+            verification: status.verification,
+        });
+    }
+    Ok(Prepared {
+        loaded,
+        bytes,
+        source,
+    })
+}
+
+/// The fields where the model's chain and the running one differ, "field: model A, running B",
+/// comma separated; empty when they agree.
+pub fn chain_differences(model: &ChainConfig, running: &ChainConfig) -> String {
+    let (Ok(a), Ok(b)) = (serde_json::to_value(model), serde_json::to_value(running)) else {
+        return "the chain configurations cannot be compared".into();
+    };
+    let (Some(a), Some(b)) = (a.as_object(), b.as_object()) else {
+        return String::new();
+    };
+    let mut out: Vec<String> = a
+        .iter()
+        .filter(|(k, v)| b.get(*k) != Some(*v))
+        .map(|(k, v)| {
+            let r = b.get(k).map_or("absent".into(), |r| r.to_string());
+            format!("{k}: model {v}, running {r}")
+        })
+        .collect();
+    out.sort();
+    out.join(", ")
+}
+
+/// Where a deployed model lives: beside the config's model path, named by its id.
+pub fn installed_path(config_model: &Path, model_id: u32) -> PathBuf {
+    let dir = config_model.parent().unwrap_or(Path::new("/"));
+    dir.join(format!("model-{model_id:08x}.hsm"))
+}
+
+/// Copies the prepared model beside the config's model path (atomically; kept as is when it
+/// is already there) and returns the config naming it, saved atomically to `config_path`.
+pub fn install(
+    p: &Prepared,
+    config: &Config,
+    config_path: &Path,
+) -> Result<(Config, PathBuf), DeployError> {
+    let target = installed_path(&config.model, p.loaded.model_id);
+    if target != p.source {
+        decoder::fsio::write_atomic(&target, &p.bytes)
+            .map_err(|e| DeployError::Install(format!("{}: {e}", target.display())))?;
+    }
+    let next = point_config(config, &target, config_path)?;
+    Ok((next, target))
+}
+
+/// The config with `model` as its model file, saved atomically to `config_path`.
+pub fn point_config(
+    config: &Config,
+    model: &Path,
+    config_path: &Path,
+) -> Result<Config, DeployError> {
+    let mut next = config.clone();
+    next.model = model.to_owned();
+    next.save_atomic(config_path)
+        .map_err(|e| DeployError::Install(format!("the config {}: {e}", config_path.display())))?;
+    Ok(next)
+}
+
+/// Appends one line to the audit log: time, who (user, uid, pid), what (`action` with its
+/// details). A failure is logged, never fatal.
+pub fn audit(log: &Path, user: &str, peer: Peer, action: &str) {
+    let time_s = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0.0, |d| d.as_secs_f64());
+    let line = format!(
+        "time={time_s:.3} user={user} uid={} pid={} {action}",
+        peer.uid, peer.pid
+    );
+    let write = || -> std::io::Result<()> {
+        if let Some(dir) = log.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)?;
+        }
+        let mut f = OpenOptions::new().create(true).append(true).open(log)?;
+        writeln!(f, "{line}")?;
+        f.sync_data()
+    };
+    if let Err(e) = write() {
+        tracing::warn!(error = %e, path = %log.display(), "audit log not written");
+    }
+}

@@ -1,0 +1,178 @@
+//! Models swapped in at a tick boundary, and the calibrating hold.
+//!
+//! A deploy prepares the model off the loop (file read, checks, the predictor's buffers all
+//! allocated by the control thread) and hands it over boxed in a [`Command::Swap`]; the tick
+//! that takes the command swaps the predictor and the model id by moving them, and sends the
+//! box, now holding the model that ran until then, back to the sender (a bounded channel's
+//! `try_send`: no allocation, no waiting). The chain and its filter state stay, so the new
+//! model runs on the very next tick's window and no tick is skipped.
+//!
+//! The calibrating hold ([`Command::Calibrating`]) latches [`Fault::Calibrating`]: the state is
+//! SAFE and every finger gets SAFE_STOP setpoints (zero force, zero velocity, brake), the same
+//! frames every other stop sends. `arm` is refused until a model has been swapped in after the
+//! hold began (a deploy, a rollback, or redeploying the running model after an aborted
+//! calibration); the `arm` that follows clears the hold.
+
+use std::sync::mpsc::SyncSender;
+
+use decoder::model::Predictor;
+
+use super::{Command, Engine};
+use crate::safety::{ArmError, Fault};
+
+/// A prepared model on its way to the loop, and the way back for the model it replaces.
+#[derive(Debug, Clone)]
+pub struct ModelSwap {
+    /// The model's predictor (None only for the "no model" a daemon may start with).
+    pub predictor: Option<Predictor>,
+    /// Its identity for HAND_HEARTBEAT.
+    pub model_id: u32,
+    /// Where the box goes back after the swap, holding the model replaced.
+    pub back: Option<SyncSender<Box<ModelSwap>>>,
+    /// Set by the loop when it swapped (false: the predictor did not fit, nothing changed).
+    pub swapped: bool,
+}
+
+/// Where the calibrating hold stands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Hold {
+    /// No hold.
+    #[default]
+    Free,
+    /// Calibrating: `arm` is refused until a model is swapped in.
+    Calibrating,
+    /// A model was swapped in since the hold began: the next `arm` releases the hand.
+    Deployed,
+}
+
+impl Engine {
+    /// The calibrating hold now.
+    pub fn hold(&self) -> Hold {
+        self.hold
+    }
+
+    /// Whether a model runs (a daemon may start without one).
+    pub fn has_model(&self) -> bool {
+        self.predictor.is_some()
+    }
+
+    /// The model id HAND_HEARTBEAT carries now.
+    pub fn model_id(&self) -> u32 {
+        self.settings.model_id
+    }
+
+    /// Begins the calibrating hold: SAFE, safe stops, `arm` refused until a model is swapped in.
+    pub(super) fn begin_hold(&mut self, now_us: u64) {
+        self.hold = Hold::Calibrating;
+        self.raise(now_us, Fault::Calibrating);
+    }
+
+    /// `arm`, refused during the calibrating hold and without a model.
+    pub(super) fn arm(&mut self, now_us: u64) -> Result<(), ArmError> {
+        if self.hold == Hold::Calibrating {
+            return Err(ArmError::Calibrating);
+        }
+        if self.predictor.is_none() {
+            return Err(ArmError::NoModel);
+        }
+        self.safety.arm(now_us)?;
+        self.hold = Hold::Free;
+        Ok(())
+    }
+
+    /// Swaps in the model in `m` by moving it (no allocation) and sends the box back with the
+    /// model replaced. A predictor that does not take the chain's features (the control side
+    /// checks this first) is sent back unswapped: its id comes back unchanged.
+    pub(super) fn swap_model(&mut self, mut m: Box<ModelSwap>) {
+        let fits = m
+            .predictor
+            .as_ref()
+            .is_some_and(|p| p.n_inputs() == self.emg.chain.settings().n_features());
+        m.swapped = fits;
+        if fits {
+            std::mem::swap(&mut self.predictor, &mut m.predictor);
+            std::mem::swap(&mut self.settings.model_id, &mut m.model_id);
+            if self.hold == Hold::Calibrating {
+                self.hold = Hold::Deployed;
+            }
+        }
+        if let Some(back) = m.back.take() {
+            // A sender that gave up waiting has dropped its end: the box is dropped here then.
+            let _ = back.try_send(m);
+        }
+    }
+}
+
+impl Command {
+    /// A swap to `predictor` with id `model_id`, whose replaced model comes back on `back`.
+    pub fn swap(predictor: Predictor, model_id: u32, back: SyncSender<Box<ModelSwap>>) -> Self {
+        Command::Swap(Box::new(ModelSwap {
+            predictor: Some(predictor),
+            model_id,
+            back: Some(back),
+            swapped: false,
+        }))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use decoder::dsp::ChainConfig;
+    use decoder::model::{
+        AnyModel, ModelKind, ModelSpec, Normalizer, TrainedModel, TrainingSummary,
+    };
+
+    use super::*;
+    use crate::engine::EngineSettings;
+    use crate::safety::DaemonState;
+
+    fn predictor() -> Predictor {
+        let chain = ChainConfig::default();
+        let n_in = 8 * chain.channels;
+        let spec = ModelSpec::default();
+        let model = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, 3).expect("model");
+        let norm = Normalizer::from_scales(vec![100.0; n_in]).expect("normalizer");
+        let summary = TrainingSummary::untrained(ModelKind::ResDd);
+        TrainedModel::new(model, spec, norm, chain, summary)
+            .expect("trained model")
+            .predictor()
+    }
+
+    #[test]
+    fn without_a_model_the_engine_is_safe_and_refuses_arm_until_a_swap() {
+        let chain = ChainConfig::default().validate().expect("chain");
+        let mut e = Engine::without_model(&chain, EngineSettings::default(), 0);
+        e.validated(0);
+        assert_eq!(e.state(), DaemonState::Safe);
+        assert!(e.faults().contains(Fault::NoModel));
+        assert_eq!(e.command(10, Command::Arm), Err(ArmError::NoModel));
+        e.command(20, Command::Calibrating).expect("hold");
+        let (tx, rx) = std::sync::mpsc::sync_channel(1);
+        e.command(30, Command::swap(predictor(), 0xabcd, tx))
+            .expect("swap");
+        let old = rx.try_recv().expect("the replaced model comes back");
+        assert!(old.swapped && old.predictor.is_none() && old.model_id == 0);
+        assert_eq!((e.model_id(), e.hold()), (0xabcd, Hold::Deployed));
+        e.command(40, Command::Arm).expect("arm after the swap");
+        assert!(e.faults().is_empty() && e.hold() == Hold::Free);
+    }
+
+    #[test]
+    fn a_predictor_that_does_not_fit_the_chain_comes_back_unswapped() {
+        let chain = ChainConfig {
+            channels: 10,
+            ..ChainConfig::default()
+        };
+        let mut e = Engine::without_model(
+            &chain.validate().expect("chain"),
+            EngineSettings::default(),
+            0,
+        );
+        let (tx, rx) = std::sync::mpsc::sync_channel(1);
+        e.command(0, Command::swap(predictor(), 7, tx))
+            .expect("swap");
+        let back = rx.try_recv().expect("sent back");
+        assert!(!back.swapped && back.model_id == 7 && back.predictor.is_some());
+        assert!(!e.has_model());
+    }
+}

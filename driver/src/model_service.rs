@@ -1,0 +1,171 @@
+//! The control side of `calibrating`, `deploy` and `rollback`: the checks and the file work run
+//! here, on the control thread; the loop only moves the prepared model in at a tick boundary
+//! and sends the one it replaced back ([`crate::engine::ModelSwap`]), which is kept for
+//! `rollback`. Every action is audited with who asked (user, uid, pid).
+
+use std::sync::mpsc::sync_channel;
+use std::time::Duration;
+
+use crate::control::Peer;
+use crate::deploy::{audit, install, point_config, prepare, DeployError};
+use crate::engine::{Command, Hold, ModelSwap};
+use crate::protocol::{ModelStatus, Reply};
+use crate::service::ControlHandler;
+
+/// How long a deploy waits for the loop to take the model (a tick or two normally).
+pub const SWAP_WAIT: Duration = Duration::from_secs(2);
+
+fn refused(e: DeployError) -> Reply {
+    Reply::Refused {
+        reason: e.to_string(),
+    }
+}
+
+impl ControlHandler {
+    /// `calibrating`: the loop holds the hand in safe stop until a deploy or rollback and an
+    /// explicit `arm`.
+    pub(crate) fn calibrating(&mut self, peer: Peer, user: &str) -> Reply {
+        if let Err(r) = self.send(Command::Calibrating) {
+            return *r;
+        }
+        self.hold = Hold::Calibrating;
+        audit(&self.config.control.audit_log, user, peer, "calibrating");
+        tracing::warn!(user, "calibrating: the hand is held in safe stop");
+        Reply::Ok {
+            message: "calibrating: the hand is held in safe stop until a model is deployed \
+                      (`handctl deploy MODEL`) or rolled back (`handctl rollback`) and then \
+                      `handctl arm`"
+                .into(),
+            status: Some(self.status()),
+        }
+    }
+
+    /// Hands `swap` to the loop and waits for the model it replaced; None if the loop did not
+    /// take it (gone, or not within [`SWAP_WAIT`]).
+    fn swap_in(
+        &self,
+        swap: Command,
+        rx: &std::sync::mpsc::Receiver<Box<ModelSwap>>,
+    ) -> Result<Box<ModelSwap>, DeployError> {
+        self.send(swap)
+            .map_err(|_| DeployError::Loop("the control loop is not running".into()))?;
+        match rx.recv_timeout(SWAP_WAIT) {
+            Ok(b) if b.swapped => Ok(b),
+            Ok(_) => Err(DeployError::Loop(
+                "the loop refused the model: its inputs do not fit the chain".into(),
+            )),
+            Err(_) => Err(DeployError::Loop(format!(
+                "the control loop did not take the model within {} s",
+                SWAP_WAIT.as_secs()
+            ))),
+        }
+    }
+
+    /// `deploy`: checked, installed, swapped in; refused with nothing changed otherwise.
+    pub(crate) fn deploy(&mut self, path: &str, force: bool, peer: Peer, user: &str) -> Reply {
+        let prepared = match prepare(path, &self.chain, force) {
+            Ok(p) => p,
+            Err(e) => return refused(e),
+        };
+        let (next, target) = match install(&prepared, &self.config, &self.config_path) {
+            Ok(x) => x,
+            Err(e) => return refused(e),
+        };
+        let status = prepared.loaded.status(&target);
+        let (tx, rx) = sync_channel(1);
+        let cmd = Command::swap(
+            prepared.loaded.model.predictor(),
+            prepared.loaded.model_id,
+            tx,
+        );
+        let old = match self.swap_in(cmd, &rx) {
+            Ok(old) => old,
+            Err(e) => {
+                self.restore_config();
+                return refused(e);
+            }
+        };
+        self.config = next;
+        let replaced = self.model.replace(status.clone());
+        self.previous = match (old.predictor.is_some(), replaced) {
+            (true, Some(s)) => Some((old, s)),
+            _ => None,
+        };
+        self.after_swap("deploy", &status, path, peer, user, force)
+    }
+
+    /// `rollback`: the model the last deploy or rollback replaced comes back (so a second
+    /// rollback undoes the first).
+    pub(crate) fn rollback(&mut self, peer: Peer, user: &str) -> Reply {
+        let Some((mut back, status)) = self.previous.take() else {
+            return refused(DeployError::NoPrevious);
+        };
+        let next = match point_config(
+            &self.config,
+            std::path::Path::new(&status.path),
+            &self.config_path,
+        ) {
+            Ok(n) => n,
+            Err(e) => {
+                self.previous = Some((back, status));
+                return refused(e);
+            }
+        };
+        let (tx, rx) = sync_channel(1);
+        back.back = Some(tx);
+        back.swapped = false;
+        let old = match self.swap_in(Command::Swap(back), &rx) {
+            Ok(old) => old,
+            Err(e) => {
+                // The box is lost with a loop that is gone; the config goes back.
+                self.restore_config();
+                return refused(e);
+            }
+        };
+        self.config = next;
+        let replaced = self.model.replace(status.clone());
+        self.previous = replaced.map(|s| (old, s));
+        let path = status.path.clone();
+        self.after_swap("rollback", &status, &path, peer, user, false)
+    }
+
+    fn restore_config(&self) {
+        if let Err(e) = self.config.save_atomic(&self.config_path) {
+            tracing::error!(error = %e, "the config could not be restored");
+        }
+    }
+
+    /// Audit, log, release the calibrating hold's first condition, and the reply.
+    fn after_swap(
+        &mut self,
+        action: &str,
+        status: &ModelStatus,
+        source: &str,
+        peer: Peer,
+        user: &str,
+        force: bool,
+    ) -> Reply {
+        self.no_model = false;
+        if self.hold == Hold::Calibrating {
+            self.hold = Hold::Deployed;
+        }
+        let what = format!(
+            "{action} path={source} installed={} id={} force={force}",
+            status.path, status.id
+        );
+        audit(&self.config.control.audit_log, user, peer, &what);
+        tracing::warn!(user, uid = peer.uid, pid = peer.pid, model = %status.path, id = %status.id, "{action}");
+        let arm = if self.hold == Hold::Deployed {
+            "; the hand stays held until `handctl arm`"
+        } else {
+            ""
+        };
+        Reply::Ok {
+            message: format!(
+                "{action}: model {} (id {}) runs from this tick on; the config names it{arm}",
+                status.path, status.id
+            ),
+            status: Some(self.status()),
+        }
+    }
+}

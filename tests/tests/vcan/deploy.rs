@@ -1,0 +1,172 @@
+//! Issue 14 over vcan: while handd drives the simulated hand with the suite's calibrated model,
+//! `handctl deploy` of a corrupted file and of a model with another chain are refused with the
+//! reason and the running model keeps driving without a missed tick; a second good model is
+//! swapped in (HAND_HEARTBEAT's ModelId on the bus changes) and `handctl rollback` brings the
+//! first id back.
+//!
+//! The second good model is the calibrated one re-saved with its rest levels (which only the
+//! monitor's display reads) scaled by one part per million: a different file, so a different
+//! id, decoding exactly as the first (training another in the VM is far too slow).
+
+use std::path::Path;
+use std::process::Command;
+use std::time::Duration;
+
+use decoder::model::TrainedModel;
+use driver::startup::fingerprint;
+use hand_dbc::messages::{FingerMode, HandHeartbeat};
+use handstack_tests::vcan::monitor::Seen;
+use handstack_tests::vcan::setpoints_of;
+
+use super::{wait_scenario_start, Rig};
+
+/// `handctl ARGS`: whether it succeeded, and what it printed.
+fn handctl_any(rig: &Rig, args: &[&str]) -> (bool, String) {
+    let sock = rig.cfg.socket.display().to_string();
+    let out = Command::new(rig.env.bin("handctl"))
+        .args(args)
+        .args(["--socket", &sock])
+        .output()
+        .expect("handctl runs");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out.status.success(), text)
+}
+
+/// The model files of the test: a corrupted copy, a model with another chain, a second good one.
+fn model_files(model: &Path, dir: &Path) -> (String, String, String, u32) {
+    let bytes = std::fs::read(model).expect("the calibrated model");
+    let mut bad = bytes.clone();
+    let mid = bad.len() / 2;
+    bad[mid] ^= 0x40;
+    let corrupt = dir.join("corrupt.hsm");
+    std::fs::write(&corrupt, &bad).expect("write the corrupted copy");
+    let m = TrainedModel::from_bytes(&bytes, None).expect("the calibrated model parses");
+    let levels: Vec<f64> = m.rest_rms_uv().map_or(vec![1.0; m.n_channels()], |r| {
+        r.iter().map(|v| v * (1.0 + 1e-6)).collect()
+    });
+    let second = dir.join("second.hsm");
+    m.clone()
+        .with_rest_rms_uv(levels)
+        .expect("rest levels")
+        .save(&second)
+        .expect("save the second model");
+    let second_id = fingerprint(&std::fs::read(&second).expect("read it back"));
+    // Another chain (a longer window), everything else the calibrated model's.
+    let other = dir.join("other-chain.hsm");
+    let chain = decoder::dsp::ChainConfig {
+        window_ms: m.chain().window_ms + 50.0,
+        ..m.chain().clone()
+    };
+    let mut o = TrainedModel::new(
+        m.model().clone(),
+        *m.spec(),
+        m.normalizer().clone(),
+        chain,
+        m.summary().clone(),
+    )
+    .expect("the model with another chain");
+    if let Some(v) = m.verification() {
+        o = o.with_verification(v.clone()).expect("its verification");
+    }
+    o.save(&other).expect("save the model with another chain");
+    (
+        corrupt.display().to_string(),
+        other.display().to_string(),
+        second.display().to_string(),
+        second_id,
+    )
+}
+
+/// HAND_HEARTBEAT's ModelId with its time.
+fn heartbeat_ids(seen: &[Seen]) -> Vec<(u64, u32)> {
+    seen.iter()
+        .filter_map(|s| {
+            let f = s.frame.as_ref()?;
+            (f.raw_id() == HandHeartbeat::ID).then_some(())?;
+            Some((s.time_us, HandHeartbeat::decode(f.data()).ok()?.model_id()))
+        })
+        .collect()
+}
+
+#[test]
+fn deploy_refuses_bad_models_swaps_a_good_one_and_rolls_back() {
+    let rig = Rig::start("deploy", 100);
+    let model = super::calibrated_model(&rig.env).to_path_buf();
+    let id_a = fingerprint(&std::fs::read(&model).expect("model"));
+    let (corrupt, other, second, id_b) = model_files(&model, &rig.dir);
+    assert_ne!(id_a, id_b);
+    let mut sim = rig.sim("sine", 10.0, &[]);
+    let start = wait_scenario_start(&rig.monitor);
+    std::thread::sleep(Duration::from_secs(2));
+    let misses = rig.cfg.status(&rig.env).deadline_misses;
+
+    let (ok, said) = handctl_any(&rig, &["deploy", &corrupt]);
+    assert!(!ok && said.contains("checksum"), "{said}");
+    let (ok, said) = handctl_any(&rig, &["deploy", &other]);
+    assert!(
+        !ok && said.contains("window_ms: model ") && said.contains("running"),
+        "{said}"
+    );
+    std::thread::sleep(Duration::from_millis(500));
+    let (ok, said) = handctl_any(&rig, &["deploy", &second]);
+    assert!(ok && said.contains(&format!("{id_b:08x}")), "{said}");
+    let deployed = handstack_tests::vcan::monitor::now_us();
+    std::thread::sleep(Duration::from_millis(1000));
+    let (ok, said) = handctl_any(&rig, &["rollback"]);
+    assert!(ok && said.contains(&format!("{id_a:08x}")), "{said}");
+    let rolled = handstack_tests::vcan::monitor::now_us();
+    std::thread::sleep(Duration::from_millis(1000));
+    let after = rig.cfg.status(&rig.env);
+    sim.wait_success(Duration::from_secs(60));
+    let seen = rig.monitor.finish();
+    check(&seen, start + 2_000_000, deployed, rolled, (id_a, id_b));
+    println!(
+        "deploy: deadline misses {misses} before, {} after the refusals, the swap and the rollback",
+        after.deadline_misses
+    );
+    assert_eq!(after.deadline_misses, misses, "a tick was missed");
+    assert_eq!(after.model.map(|m| m.id), Some(format!("{id_a:08x}")));
+}
+
+/// ModelId A until the deploy, B after it, A again after the rollback; ACTIVE setpoints of
+/// the thumb every tick throughout (the running model drives the hand, no tick skipped).
+fn check(seen: &[Seen], from: u64, deployed: u64, rolled: u64, (a, b): (u32, u32)) {
+    let ids = heartbeat_ids(seen);
+    assert!(ids
+        .iter()
+        .filter(|h| h.0 >= from && h.0 < deployed - 100_000)
+        .all(|h| h.1 == a));
+    assert!(
+        ids.iter()
+            .any(|h| h.0 > deployed && h.0 < rolled && h.1 == b),
+        "B never on the bus"
+    );
+    let last = ids.last().expect("heartbeats");
+    assert_eq!(last.1, a, "the rollback's id is the first model's");
+    let thumb: Vec<_> = setpoints_of(seen)
+        .into_iter()
+        .filter(|s| s.finger == 0 && s.time_us >= from && s.time_us <= rolled + 500_000)
+        .collect();
+    let gaps = thumb
+        .windows(2)
+        .map(|w| w[1].time_us - w[0].time_us)
+        .max()
+        .unwrap_or(0);
+    let active = thumb
+        .iter()
+        .filter(|s| s.mode == FingerMode::Active)
+        .count();
+    println!(
+        "deploy: {} thumb setpoints, {active} ACTIVE, longest gap {gaps} us",
+        thumb.len()
+    );
+    assert!(
+        active == thumb.len() && !thumb.is_empty(),
+        "the hand stopped being driven"
+    );
+    assert!(gaps < 100_000, "a gap of {gaps} us between setpoints");
+}
