@@ -10,7 +10,9 @@ Run by can-dbc/tests/cantools.rs; usable by hand:
 2. For every Rust vector (message id, physical values, payload bytes produced by the Rust
    codec): cantools must encode the same values to the same bytes, and decode the Rust bytes
    to the same values. For E2E-protected messages, the CRC byte is recomputed here with an
-   independent bitwise CRC-8 SAE J1850 over the data id and the payload.
+   independent bitwise CRC-8 SAE J1850 over the data id and the payload. A vector that carries
+   "info" (the generated MESSAGES entry: senders, receivers, cycle time, E2E data id, and
+   per signal unit and value table) must match the message as cantools read it.
 3. Writes its own vectors (random in-range values encoded by cantools) for the Rust side to
    decode and re-encode.
 
@@ -85,6 +87,31 @@ def e2e_of(db, msg):
     return data_id
 
 
+def info_problems(db, msg, info):
+    """Differences between the generated MESSAGES entry and the message as cantools read it."""
+    out = []
+    if sorted(info["senders"]) != sorted(msg.senders):
+        out.append(f"{msg.name}: senders Rust {info['senders']} cantools {msg.senders}")
+    receivers = sorted({r for sig in msg.signals for r in sig.receivers if r != "Vector__XXX"})
+    if sorted(info["receivers"]) != receivers:
+        out.append(f"{msg.name}: receivers Rust {info['receivers']} cantools {receivers}")
+    if info["cycle_time_ms"] != (msg.cycle_time or 0):
+        out.append(f"{msg.name}: cycle time Rust {info['cycle_time_ms']} cantools {msg.cycle_time}")
+    if info["e2e_data_id"] != e2e_of(db, msg):
+        out.append(f"{msg.name}: E2E data id Rust {info['e2e_data_id']:#06x} cantools {e2e_of(db, msg):#06x}")
+    for sig in msg.signals:
+        mine = info["signals"].get(sig.name)
+        if mine is None:
+            out.append(f"{msg.name}.{sig.name}: missing in Rust's MESSAGES")
+            continue
+        theirs = {str(int(k)): str(v) for k, v in (sig.choices or {}).items()}
+        if mine["choices"] != theirs:
+            out.append(f"{msg.name}.{sig.name}: value table Rust {mine['choices']} cantools {theirs}")
+        if mine["unit"] != (sig.unit or ""):
+            out.append(f"{msg.name}.{sig.name}: unit Rust {mine['unit']!r} cantools {sig.unit!r}")
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--dbc", required=True)
@@ -108,12 +135,16 @@ def main():
         failures.append(f"message ids differ: only in Rust {sorted(rust_ids - db_ids)}, only in cantools {sorted(db_ids - rust_ids)}")
 
     counts = {}
+    described = set()
     for vec in rust:
         try:
             msg = db.get_message_by_frame_id(vec["id"])
         except KeyError:
             continue
         counts[msg.name] = counts.get(msg.name, 0) + 1
+        if "info" in vec:
+            described.add(msg.name)
+            failures += info_problems(db, msg, vec["info"])
         data = bytes.fromhex(vec["data"])
         values = vec["values"]
         names = {s.name for s in msg.signals}
@@ -143,6 +174,8 @@ def main():
             if data[0] != want:
                 failures.append(f"{msg.name}: CRC byte {data[0]:#04x} != J1850 over data id {data_id:#06x} + payload: {want:#04x}")
     for m in db.messages:
+        if m.name not in described:
+            failures.append(f"{m.name}: no Rust vector carried its MESSAGES entry")
         if counts.get(m.name, 0) < args.n:
             failures.append(f"{m.name}: only {counts.get(m.name, 0)} Rust vectors, need {args.n}")
 

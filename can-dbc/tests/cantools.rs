@@ -3,6 +3,8 @@
 //! Rust writes >= 1000 random in-range vectors per message (values + bytes, E2E counter and
 //! CRC computed by the Rust protector side), cantools re-encodes and decodes them, checks the
 //! CRC independently and writes its own random vectors, which Rust then decodes and re-encodes.
+//! Each message's first vector also carries the generated `MESSAGES` entry (sender, receivers,
+//! cycle time, E2E data id, units, value tables), which cantools compares with what it read.
 
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -66,7 +68,35 @@ fn rust_vector(rng: &mut impl Rng, info: &MessageInfo, k: usize) -> Value {
         out.insert(n.to_string(), v);
     });
     let hex: String = frame.data().iter().map(|b| format!("{b:02x}")).collect();
-    json!({ "id": info.id, "name": info.name, "values": out, "data": hex })
+    let mut v = json!({ "id": info.id, "name": info.name, "values": out, "data": hex });
+    if k == 0 {
+        v["info"] = info_json(info);
+    }
+    v
+}
+
+/// The generated description of a message, for cantools to compare with the DBC it read.
+fn info_json(info: &MessageInfo) -> Value {
+    let signals: serde_json::Map<String, Value> = info
+        .signals
+        .iter()
+        .map(|s| {
+            let choices: serde_json::Map<String, Value> = s
+                .values
+                .iter()
+                .map(|(raw, name)| (raw.to_string(), json!(name)))
+                .collect();
+            let sig = json!({ "unit": s.unit, "choices": choices });
+            (s.name.to_string(), sig)
+        })
+        .collect();
+    json!({
+        "senders": info.senders,
+        "receivers": info.receivers,
+        "cycle_time_ms": info.cycle_time_ms,
+        "e2e_data_id": info.e2e.map_or(0, |p| p.data_id()),
+        "signals": signals,
+    })
 }
 
 fn unhex(s: &str) -> Vec<u8> {

@@ -2,8 +2,8 @@
 
 use hand_dbc::e2e::{E2eChecker, E2eProtector, E2eStatus};
 use hand_dbc::messages::{
-    self, decode, CodecError, EmgSamplesG1, FingerMode, FingerSetpoint, FingerStatus, HandDiag,
-    HandEstop, Message, MESSAGES,
+    self, decode, CalibrationCue, CodecError, CueKind, CuePhase, EmgSamplesG1, FingerMode,
+    FingerSetpoint, FingerStatus, HandDiag, HandEstop, Message, MESSAGES,
 };
 use hand_dbc::CanFrame;
 
@@ -173,4 +173,66 @@ fn physical_values_round_to_the_nearest_step_within_the_range() {
     assert!(st.set_position(2.01).is_err());
     assert!(st.set_position(-0.51).is_err());
     assert_eq!(st.id(), 0x283);
+}
+
+#[test]
+fn calibration_cue_lays_out_as_the_dbc_says_and_refuses_what_it_cannot_mean() {
+    // HOLD of trial 7: index flexion, repetition 2, second attempt, 4.25 s left, 100 %.
+    let cue = CalibrationCue::new(CuePhase::Hold, 7, 1, CueKind::Flexion, 2, 1, 4.25, 100)
+        .expect("in range");
+    assert_eq!(
+        (CalibrationCue::ID, CalibrationCue::CYCLE_TIME_MS),
+        (0x380, 100)
+    );
+    assert_eq!(CalibrationCue::E2E.data_id(), 0x1380);
+    // Phase 12|4, Trial 16|8, Finger 24|4, Kind 28|4, Repetition 32|4, Attempt 36|4,
+    // TimeLeft 40|16 (425 = 0x01A9), Effort 56|8, all little-endian; CRC and counter still 0.
+    assert_eq!(
+        cue.encode(),
+        [0x00, 0x20, 0x07, 0x11, 0x12, 0xA9, 0x01, 0x64]
+    );
+    let mut tx = E2eProtector::new(CalibrationCue::E2E);
+    let mut rx = E2eChecker::try_new(CalibrationCue::E2E, 1).expect("valid config");
+    let frame = tx.protect_message(&cue).expect("right profile");
+    assert_eq!(rx.check_frame(Some(&frame)), E2eStatus::Ok);
+    match messages::decode_frame(&frame).expect("decodes") {
+        Message::CalibrationCue(m) => {
+            assert_eq!(
+                (m.phase(), m.kind(), m.finger()),
+                (CuePhase::Hold, CueKind::Flexion, 1)
+            );
+            assert!((m.time_left() - 4.25).abs() < 1e-9);
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+    assert!(CalibrationCue::new(CuePhase::Hold, 7, 1, CueKind::Flexion, 2, 1, 4.25, 101).is_err());
+    assert!(CalibrationCue::new(CuePhase::Hold, 7, 16, CueKind::Flexion, 2, 1, 4.25, 100).is_err());
+    assert!(CalibrationCue::new(CuePhase::Hold, 7, 1, CueKind::Rest, 16, 0, 0.0, 100).is_err());
+    assert!(CalibrationCue::new(CuePhase::Relax, 7, 1, CueKind::Rest, 0, 0, 655.36, 100).is_err());
+    // Phase 6 and Kind 3 are in no value table; Effort 101 is over the DBC max.
+    let bytes = cue.encode();
+    let mut bad_phase = bytes;
+    bad_phase[1] = 0x60;
+    assert!(matches!(
+        decode(0x380, &bad_phase),
+        Err(CodecError::UnknownValue {
+            signal: "Phase",
+            ..
+        })
+    ));
+    let mut bad_kind = bytes;
+    bad_kind[3] = 0x31;
+    assert!(matches!(
+        decode(0x380, &bad_kind),
+        Err(CodecError::UnknownValue { signal: "Kind", .. })
+    ));
+    let mut bad_effort = bytes;
+    bad_effort[7] = 101;
+    assert!(matches!(
+        decode(0x380, &bad_effort),
+        Err(CodecError::RawOutOfRange {
+            signal: "Effort",
+            ..
+        })
+    ));
 }

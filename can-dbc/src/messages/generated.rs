@@ -188,6 +188,116 @@ impl AmpState {
     }
 }
 
+/// Value table `CueKind` of hand.dbc.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CueKind {
+    /// `REST` (raw 0)
+    Rest,
+    /// `FLEXION` (raw 1)
+    Flexion,
+    /// `EXTENSION` (raw 2)
+    Extension,
+}
+
+impl CueKind {
+    /// Every value, in raw order.
+    pub const ALL: [CueKind; 3] = [CueKind::Rest, CueKind::Flexion, CueKind::Extension];
+
+    /// The raw value on the bus.
+    pub const fn raw(self) -> u8 {
+        match self {
+            CueKind::Rest => 0,
+            CueKind::Flexion => 1,
+            CueKind::Extension => 2,
+        }
+    }
+
+    /// The value for a raw value, `None` if the table does not name it.
+    pub const fn from_raw(raw: i64) -> Option<Self> {
+        match raw {
+            0 => Some(CueKind::Rest),
+            1 => Some(CueKind::Flexion),
+            2 => Some(CueKind::Extension),
+            _ => None,
+        }
+    }
+
+    /// The name hand.dbc gives this value.
+    pub const fn dbc_name(self) -> &'static str {
+        match self {
+            CueKind::Rest => "REST",
+            CueKind::Flexion => "FLEXION",
+            CueKind::Extension => "EXTENSION",
+        }
+    }
+}
+
+/// Value table `CuePhase` of hand.dbc.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CuePhase {
+    /// `IDLE` (raw 0)
+    Idle,
+    /// `PREPARE` (raw 1)
+    Prepare,
+    /// `HOLD` (raw 2)
+    Hold,
+    /// `RELAX` (raw 3)
+    Relax,
+    /// `DONE` (raw 4)
+    Done,
+    /// `ABORTED` (raw 5)
+    Aborted,
+}
+
+impl CuePhase {
+    /// Every value, in raw order.
+    pub const ALL: [CuePhase; 6] = [
+        CuePhase::Idle,
+        CuePhase::Prepare,
+        CuePhase::Hold,
+        CuePhase::Relax,
+        CuePhase::Done,
+        CuePhase::Aborted,
+    ];
+
+    /// The raw value on the bus.
+    pub const fn raw(self) -> u8 {
+        match self {
+            CuePhase::Idle => 0,
+            CuePhase::Prepare => 1,
+            CuePhase::Hold => 2,
+            CuePhase::Relax => 3,
+            CuePhase::Done => 4,
+            CuePhase::Aborted => 5,
+        }
+    }
+
+    /// The value for a raw value, `None` if the table does not name it.
+    pub const fn from_raw(raw: i64) -> Option<Self> {
+        match raw {
+            0 => Some(CuePhase::Idle),
+            1 => Some(CuePhase::Prepare),
+            2 => Some(CuePhase::Hold),
+            3 => Some(CuePhase::Relax),
+            4 => Some(CuePhase::Done),
+            5 => Some(CuePhase::Aborted),
+            _ => None,
+        }
+    }
+
+    /// The name hand.dbc gives this value.
+    pub const fn dbc_name(self) -> &'static str {
+        match self {
+            CuePhase::Idle => "IDLE",
+            CuePhase::Prepare => "PREPARE",
+            CuePhase::Hold => "HOLD",
+            CuePhase::Relax => "RELAX",
+            CuePhase::Done => "DONE",
+            CuePhase::Aborted => "ABORTED",
+        }
+    }
+}
+
 /// Value table `DaemonState` of hand.dbc.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum DaemonState {
@@ -4810,6 +4920,572 @@ impl HandDiag {
     }
 }
 
+/// Message CALIBRATION_CUE (id 0x380).
+///
+/// Calibration cue from the technician tool (handctl calibrate) to the patient: what to do now. Sent at 10 Hz and at once on every change of phase, only while a calibration runs. A patient-facing display (AMP side) or the simulated patient follows it; handd ignores it. A receiver that sees no valid cue for 1 s takes the calibration as gone and rests.
+///
+/// DLC 8, every 100 ms, sent by TOOL, received by HAND, AMP. E2E protected: CRC-8 in byte 0, 4-bit alive counter (data id 0x1380)
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct CalibrationCue {
+    crc: u8,
+    counter: u8,
+    phase: CuePhase,
+    trial: u8,
+    finger: u8,
+    kind: CueKind,
+    repetition: u8,
+    attempt: u8,
+    time_left: u16,
+    effort: u8,
+}
+
+impl CalibrationCue {
+    /// Name in hand.dbc.
+    pub const NAME: &'static str = "CALIBRATION_CUE";
+    /// CAN id (11-bit).
+    pub const ID: u32 = 0x380;
+    /// Payload length in bytes.
+    pub const DLC: usize = 8;
+    /// Send period from `GenMsgCycleTime` (ms).
+    pub const CYCLE_TIME_MS: u32 = 100;
+    /// E2E profile.
+    pub const E2E: E2eProfile = E2eProfile::from_dbc(0x1380, 4, 8);
+    /// Smallest allowed `Crc` (crc).
+    pub const CRC_MIN: u8 = 0;
+    /// Largest allowed `Crc` (crc).
+    pub const CRC_MAX: u8 = 255;
+    /// Smallest allowed `Counter` (count).
+    pub const COUNTER_MIN: u8 = 0;
+    /// Largest allowed `Counter` (count).
+    pub const COUNTER_MAX: u8 = 15;
+    /// Smallest allowed `Trial` (index).
+    pub const TRIAL_MIN: u8 = 0;
+    /// Largest allowed `Trial` (index).
+    pub const TRIAL_MAX: u8 = 255;
+    /// Smallest allowed `Finger` (finger).
+    pub const FINGER_MIN: u8 = 0;
+    /// Largest allowed `Finger` (finger).
+    pub const FINGER_MAX: u8 = 15;
+    /// Smallest allowed `Repetition` (count).
+    pub const REPETITION_MIN: u8 = 0;
+    /// Largest allowed `Repetition` (count).
+    pub const REPETITION_MAX: u8 = 15;
+    /// Smallest allowed `Attempt` (count).
+    pub const ATTEMPT_MIN: u8 = 0;
+    /// Largest allowed `Attempt` (count).
+    pub const ATTEMPT_MAX: u8 = 15;
+    /// Smallest allowed `TimeLeft` (s).
+    pub const TIME_LEFT_MIN: f64 = 0.0;
+    /// Largest allowed `TimeLeft` (s).
+    pub const TIME_LEFT_MAX: f64 = 655.35;
+    /// `TimeLeft`: s per raw step.
+    pub const TIME_LEFT_FACTOR: f64 = 0.01;
+    /// `TimeLeft`: physical value of raw 0 (s).
+    pub const TIME_LEFT_OFFSET: f64 = 0.0;
+    /// Smallest allowed raw `TimeLeft` on the bus.
+    pub const TIME_LEFT_RAW_MIN: u16 = 0;
+    /// Largest allowed raw `TimeLeft` on the bus.
+    pub const TIME_LEFT_RAW_MAX: u16 = 65535;
+    /// Smallest allowed `Effort` (%).
+    pub const EFFORT_MIN: u8 = 0;
+    /// Largest allowed `Effort` (%).
+    pub const EFFORT_MAX: u8 = 100;
+
+    /// Builds the message from physical values, each checked against hand.dbc. Crc and Counter start at 0: an [`crate::e2e::E2eProtector`] fills them when sending.
+    #[allow(clippy::too_many_arguments, reason = "one argument per DBC signal")]
+    pub fn new(
+        phase: CuePhase,
+        trial: u8,
+        finger: u8,
+        kind: CueKind,
+        repetition: u8,
+        attempt: u8,
+        time_left: f64,
+        effort: u8,
+    ) -> Result<Self, CodecError> {
+        let mut msg = Self {
+            crc: 0,
+            counter: 0,
+            phase: CuePhase::ALL[0],
+            trial: 0,
+            finger: 0,
+            kind: CueKind::ALL[0],
+            repetition: 0,
+            attempt: 0,
+            time_left: 0,
+            effort: 0,
+        };
+        msg.set_phase(phase);
+        msg.set_trial(trial)?;
+        msg.set_finger(finger)?;
+        msg.set_kind(kind);
+        msg.set_repetition(repetition)?;
+        msg.set_attempt(attempt)?;
+        msg.set_time_left(time_left)?;
+        msg.set_effort(effort)?;
+        Ok(msg)
+    }
+
+    /// CAN id.
+    pub fn id(&self) -> u32 {
+        Self::ID
+    }
+
+    /// DBC name.
+    pub fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    /// E2E profile.
+    pub fn e2e(&self) -> E2eProfile {
+        Self::E2E
+    }
+
+    /// `Crc` (crc): CRC-8 SAE J1850 over data id 0x1380 and bytes 1..7.
+    pub fn crc(&self) -> u8 {
+        self.crc
+    }
+
+    /// Sets `Crc`; refuses values outside [0, 255].
+    pub fn set_crc(&mut self, value: u8) -> Result<(), CodecError> {
+        self.crc = value;
+        Ok(())
+    }
+
+    /// `Counter` (count): 4-bit alive counter.
+    pub fn counter(&self) -> u8 {
+        self.counter
+    }
+
+    /// Sets `Counter`; refuses values outside [0, 15].
+    pub fn set_counter(&mut self, value: u8) -> Result<(), CodecError> {
+        if value > 15 {
+            return Err(CodecError::RawOutOfRange {
+                message: Self::NAME,
+                signal: "Counter",
+                raw: i64::from(value),
+                min: 0,
+                max: 15,
+            });
+        }
+        self.counter = value;
+        Ok(())
+    }
+
+    /// `Phase` (enum): IDLE: no trial yet (or between trials); PREPARE: get ready for the trial named, stay at rest; HOLD: contract now as cued and hold; RELAX: let go, back to rest; DONE: the protocol is finished; ABORTED: the calibration was stopped. Every phase but HOLD means rest.
+    pub fn phase(&self) -> CuePhase {
+        self.phase
+    }
+
+    /// Sets `Phase` (every enum value is in range).
+    pub fn set_phase(&mut self, value: CuePhase) {
+        self.phase = value;
+    }
+
+    /// `Trial` (index): Index of the trial in the protocol (0..254); 255 = none (IDLE, DONE, ABORTED).
+    pub fn trial(&self) -> u8 {
+        self.trial
+    }
+
+    /// Sets `Trial`; refuses values outside [0, 255].
+    pub fn set_trial(&mut self, value: u8) -> Result<(), CodecError> {
+        self.trial = value;
+        Ok(())
+    }
+
+    /// `Finger` (finger): Cued finger: 0 thumb, 1 index, 2 middle, 3 ring, 4 pinky, 5 the whole hand (all five), 15 none (rest). 6..14 are not used; a receiver takes them as none.
+    pub fn finger(&self) -> u8 {
+        self.finger
+    }
+
+    /// Sets `Finger`; refuses values outside [0, 15].
+    pub fn set_finger(&mut self, value: u8) -> Result<(), CodecError> {
+        if value > 15 {
+            return Err(CodecError::RawOutOfRange {
+                message: Self::NAME,
+                signal: "Finger",
+                raw: i64::from(value),
+                min: 0,
+                max: 15,
+            });
+        }
+        self.finger = value;
+        Ok(())
+    }
+
+    /// `Kind` (enum): REST: stay relaxed; FLEXION: maximal flexion of the cued finger(s) (label +1); EXTENSION: maximal extension (label -1).
+    pub fn kind(&self) -> CueKind {
+        self.kind
+    }
+
+    /// Sets `Kind` (every enum value is in range).
+    pub fn set_kind(&mut self, value: CueKind) {
+        self.kind = value;
+    }
+
+    /// `Repetition` (count): Repetition of this trial's movement in the protocol, 0-based.
+    pub fn repetition(&self) -> u8 {
+        self.repetition
+    }
+
+    /// Sets `Repetition`; refuses values outside [0, 15].
+    pub fn set_repetition(&mut self, value: u8) -> Result<(), CodecError> {
+        if value > 15 {
+            return Err(CodecError::RawOutOfRange {
+                message: Self::NAME,
+                signal: "Repetition",
+                raw: i64::from(value),
+                min: 0,
+                max: 15,
+            });
+        }
+        self.repetition = value;
+        Ok(())
+    }
+
+    /// `Attempt` (count): Attempt at this trial, 0 = first; a trial repeated after a failed quality check counts up (modulo 16).
+    pub fn attempt(&self) -> u8 {
+        self.attempt
+    }
+
+    /// Sets `Attempt`; refuses values outside [0, 15].
+    pub fn set_attempt(&mut self, value: u8) -> Result<(), CodecError> {
+        if value > 15 {
+            return Err(CodecError::RawOutOfRange {
+                message: Self::NAME,
+                signal: "Attempt",
+                raw: i64::from(value),
+                min: 0,
+                max: 15,
+            });
+        }
+        self.attempt = value;
+        Ok(())
+    }
+
+    /// `TimeLeft` (s): Time left in the current phase, 0.01 s per LSB (0..655.35 s).
+    pub fn time_left(&self) -> f64 {
+        f64::from(self.time_left) * 0.01
+    }
+
+    /// `TimeLeft` as the raw integer on the bus.
+    pub fn time_left_raw(&self) -> u16 {
+        self.time_left
+    }
+
+    /// Sets `TimeLeft` from a physical value, rounded to the nearest raw step; refuses non-finite values and values outside [0, 655.35] s (never wraps or saturates).
+    pub fn set_time_left(&mut self, value: f64) -> Result<(), CodecError> {
+        let tol = 1e-8;
+        if !value.is_finite()
+            || value < Self::TIME_LEFT_MIN - tol
+            || value > Self::TIME_LEFT_MAX + tol
+        {
+            return Err(CodecError::OutOfRange {
+                message: Self::NAME,
+                signal: "TimeLeft",
+                value,
+                min: Self::TIME_LEFT_MIN,
+                max: Self::TIME_LEFT_MAX,
+                unit: "s",
+            });
+        }
+        let raw = ((value - 0.0) / 0.01).round() as i64;
+        if !(0..=65535).contains(&raw) {
+            return Err(CodecError::OutOfRange {
+                message: Self::NAME,
+                signal: "TimeLeft",
+                value,
+                min: Self::TIME_LEFT_MIN,
+                max: Self::TIME_LEFT_MAX,
+                unit: "s",
+            });
+        }
+        self.time_left = raw as u16;
+        Ok(())
+    }
+
+    /// Sets `TimeLeft` from a raw value; refuses raw values outside [0, 65535].
+    pub fn set_time_left_raw(&mut self, raw: u16) -> Result<(), CodecError> {
+        self.time_left = raw;
+        Ok(())
+    }
+
+    /// `Effort` (%): Requested effort in percent of maximal voluntary contraction; 100 for a normal cue.
+    pub fn effort(&self) -> u8 {
+        self.effort
+    }
+
+    /// Sets `Effort`; refuses values outside [0, 100].
+    pub fn set_effort(&mut self, value: u8) -> Result<(), CodecError> {
+        if value > 100 {
+            return Err(CodecError::RawOutOfRange {
+                message: Self::NAME,
+                signal: "Effort",
+                raw: i64::from(value),
+                min: 0,
+                max: 100,
+            });
+        }
+        self.effort = value;
+        Ok(())
+    }
+
+    /// Decodes a payload; refuses a wrong length, raw values outside the DBC range and values the value tables do not name. The CRC is not checked here: that is [`crate::e2e::E2eChecker`]'s job.
+    pub fn decode(data: &[u8]) -> Result<Self, CodecError> {
+        let message = Self::NAME;
+        if data.len() != Self::DLC {
+            return Err(CodecError::WrongLength {
+                message,
+                expected: Self::DLC,
+                got: data.len(),
+            });
+        }
+        let mut bytes = [0u8; 8];
+        bytes[..Self::DLC].copy_from_slice(data);
+        let bits = u64::from_le_bytes(bytes);
+        let crc = (bits & 0xff) as u8;
+        let counter = ((bits >> 8) & 0xf) as u8;
+        let phase = ((bits >> 12) & 0xf) as u8;
+        let Some(phase) = CuePhase::from_raw(i64::from(phase)) else {
+            return Err(CodecError::UnknownValue {
+                message,
+                signal: "Phase",
+                raw: i64::from(phase),
+            });
+        };
+        let trial = ((bits >> 16) & 0xff) as u8;
+        let finger = ((bits >> 24) & 0xf) as u8;
+        let kind = ((bits >> 28) & 0xf) as u8;
+        let Some(kind) = CueKind::from_raw(i64::from(kind)) else {
+            return Err(CodecError::UnknownValue {
+                message,
+                signal: "Kind",
+                raw: i64::from(kind),
+            });
+        };
+        let repetition = ((bits >> 32) & 0xf) as u8;
+        let attempt = ((bits >> 36) & 0xf) as u8;
+        let time_left = ((bits >> 40) & 0xffff) as u16;
+        let effort = ((bits >> 56) & 0xff) as u8;
+        if effort > 100 {
+            return Err(CodecError::RawOutOfRange {
+                message,
+                signal: "Effort",
+                raw: i64::from(effort),
+                min: 0,
+                max: 100,
+            });
+        }
+        Ok(Self {
+            crc,
+            counter,
+            phase,
+            trial,
+            finger,
+            kind,
+            repetition,
+            attempt,
+            time_left,
+            effort,
+        })
+    }
+
+    /// The payload bytes (values were range-checked when set, so this cannot fail).
+    pub fn encode(&self) -> [u8; 8] {
+        let mut bits = 0u64;
+        bits |= u64::from(self.crc) & 0xff;
+        bits |= (u64::from(self.counter) & 0xf) << 8;
+        bits |= (u64::from(self.phase.raw()) & 0xf) << 12;
+        bits |= (u64::from(self.trial) & 0xff) << 16;
+        bits |= (u64::from(self.finger) & 0xf) << 24;
+        bits |= (u64::from(self.kind.raw()) & 0xf) << 28;
+        bits |= (u64::from(self.repetition) & 0xf) << 32;
+        bits |= (u64::from(self.attempt) & 0xf) << 36;
+        bits |= (u64::from(self.time_left) & 0xffff) << 40;
+        bits |= (u64::from(self.effort) & 0xff) << 56;
+        bits.to_le_bytes()
+    }
+
+    /// The message as a [`CanFrame`].
+    pub fn to_frame(&self) -> CanFrame {
+        CanFrame::from_dbc(self.id(), &self.encode())
+    }
+
+    /// The message as any [`embedded_can::Frame`] (e.g. a SocketCAN frame).
+    pub fn to_can_frame<F: embedded_can::Frame>(&self) -> Result<F, CodecError> {
+        to_can_frame(self.id(), &self.encode())
+    }
+
+    /// Decodes any [`embedded_can::Frame`]; refuses remote frames, extended ids and other messages' ids.
+    pub fn try_from_frame<F: embedded_can::Frame>(frame: &F) -> Result<Self, CodecError> {
+        let id = standard_data_frame(frame)?;
+        if id != Self::ID {
+            return Err(CodecError::WrongId {
+                message: Self::NAME,
+                id,
+            });
+        }
+        Self::decode(frame.data())
+    }
+
+    /// Calls `f` with each signal's DBC name and physical value (enums as their raw value).
+    pub fn for_each_signal(&self, f: &mut dyn FnMut(&'static str, f64)) {
+        f("Crc", f64::from(self.crc));
+        f("Counter", f64::from(self.counter));
+        f("Phase", f64::from(self.phase.raw()));
+        f("Trial", f64::from(self.trial));
+        f("Finger", f64::from(self.finger));
+        f("Kind", f64::from(self.kind.raw()));
+        f("Repetition", f64::from(self.repetition));
+        f("Attempt", f64::from(self.attempt));
+        f("TimeLeft", self.time_left());
+        f("Effort", f64::from(self.effort));
+    }
+
+    /// Builds the message from physical values looked up by DBC signal name (enums by raw value), each checked; E2E signals included.
+    pub fn from_signals(get: &mut dyn FnMut(&str) -> Option<f64>) -> Result<Self, CodecError> {
+        let message = Self::NAME;
+        let mut msg = Self {
+            crc: 0,
+            counter: 0,
+            phase: CuePhase::ALL[0],
+            trial: 0,
+            finger: 0,
+            kind: CueKind::ALL[0],
+            repetition: 0,
+            attempt: 0,
+            time_left: 0,
+            effort: 0,
+        };
+        let v = get("Crc").ok_or(CodecError::MissingSignal {
+            message,
+            signal: "Crc",
+        })?;
+        let raw = whole(message, "Crc", v)?;
+        let raw = u8::try_from(raw).map_err(|_| CodecError::RawOutOfRange {
+            message,
+            signal: "Crc",
+            raw,
+            min: 0,
+            max: 255,
+        })?;
+        msg.set_crc(raw)?;
+        let v = get("Counter").ok_or(CodecError::MissingSignal {
+            message,
+            signal: "Counter",
+        })?;
+        let raw = whole(message, "Counter", v)?;
+        let raw = u8::try_from(raw).map_err(|_| CodecError::RawOutOfRange {
+            message,
+            signal: "Counter",
+            raw,
+            min: 0,
+            max: 15,
+        })?;
+        msg.set_counter(raw)?;
+        let v = get("Phase").ok_or(CodecError::MissingSignal {
+            message,
+            signal: "Phase",
+        })?;
+        let raw = whole(message, "Phase", v)?;
+        msg.phase = CuePhase::from_raw(raw).ok_or(CodecError::UnknownValue {
+            message,
+            signal: "Phase",
+            raw,
+        })?;
+        let v = get("Trial").ok_or(CodecError::MissingSignal {
+            message,
+            signal: "Trial",
+        })?;
+        let raw = whole(message, "Trial", v)?;
+        let raw = u8::try_from(raw).map_err(|_| CodecError::RawOutOfRange {
+            message,
+            signal: "Trial",
+            raw,
+            min: 0,
+            max: 255,
+        })?;
+        msg.set_trial(raw)?;
+        let v = get("Finger").ok_or(CodecError::MissingSignal {
+            message,
+            signal: "Finger",
+        })?;
+        let raw = whole(message, "Finger", v)?;
+        let raw = u8::try_from(raw).map_err(|_| CodecError::RawOutOfRange {
+            message,
+            signal: "Finger",
+            raw,
+            min: 0,
+            max: 15,
+        })?;
+        msg.set_finger(raw)?;
+        let v = get("Kind").ok_or(CodecError::MissingSignal {
+            message,
+            signal: "Kind",
+        })?;
+        let raw = whole(message, "Kind", v)?;
+        msg.kind = CueKind::from_raw(raw).ok_or(CodecError::UnknownValue {
+            message,
+            signal: "Kind",
+            raw,
+        })?;
+        let v = get("Repetition").ok_or(CodecError::MissingSignal {
+            message,
+            signal: "Repetition",
+        })?;
+        let raw = whole(message, "Repetition", v)?;
+        let raw = u8::try_from(raw).map_err(|_| CodecError::RawOutOfRange {
+            message,
+            signal: "Repetition",
+            raw,
+            min: 0,
+            max: 15,
+        })?;
+        msg.set_repetition(raw)?;
+        let v = get("Attempt").ok_or(CodecError::MissingSignal {
+            message,
+            signal: "Attempt",
+        })?;
+        let raw = whole(message, "Attempt", v)?;
+        let raw = u8::try_from(raw).map_err(|_| CodecError::RawOutOfRange {
+            message,
+            signal: "Attempt",
+            raw,
+            min: 0,
+            max: 15,
+        })?;
+        msg.set_attempt(raw)?;
+        let v = get("TimeLeft").ok_or(CodecError::MissingSignal {
+            message,
+            signal: "TimeLeft",
+        })?;
+        msg.set_time_left(v)?;
+        let v = get("Effort").ok_or(CodecError::MissingSignal {
+            message,
+            signal: "Effort",
+        })?;
+        let raw = whole(message, "Effort", v)?;
+        let raw = u8::try_from(raw).map_err(|_| CodecError::RawOutOfRange {
+            message,
+            signal: "Effort",
+            raw,
+            min: 0,
+            max: 100,
+        })?;
+        msg.set_effort(raw)?;
+        Ok(msg)
+    }
+}
+
+impl crate::e2e::Protected for CalibrationCue {
+    fn e2e_profile(&self) -> E2eProfile {
+        self.e2e()
+    }
+    fn to_frame(&self) -> CanFrame {
+        CalibrationCue::to_frame(self)
+    }
+}
+
 /// Any message of hand.dbc, as decoded by [`decode`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Message {
@@ -4831,6 +5507,8 @@ pub enum Message {
     HandHeartbeat(HandHeartbeat),
     /// HAND_DIAG
     HandDiag(HandDiag),
+    /// CALIBRATION_CUE
+    CalibrationCue(CalibrationCue),
 }
 
 /// Decodes a payload by CAN id into the matching message; refuses unknown ids, wrong lengths, out-of-range raw values and unnamed enum values. Never panics.
@@ -4845,6 +5523,7 @@ pub fn decode(id: u32, data: &[u8]) -> Result<Message, CodecError> {
         0x280..=0x284 => FingerStatus::decode(id, data).map(Message::FingerStatus),
         0x300 => HandHeartbeat::decode(data).map(Message::HandHeartbeat),
         0x301 => HandDiag::decode(data).map(Message::HandDiag),
+        0x380 => CalibrationCue::decode(data).map(Message::CalibrationCue),
         _ => Err(CodecError::UnknownId { id }),
     }
 }
@@ -4876,6 +5555,7 @@ pub fn from_signals(
         }
         0x300 => HandHeartbeat::from_signals(get).map(Message::HandHeartbeat),
         0x301 => HandDiag::from_signals(get).map(Message::HandDiag),
+        0x380 => CalibrationCue::from_signals(get).map(Message::CalibrationCue),
         _ => Err(CodecError::UnknownId { id }),
     }
 }
@@ -4893,6 +5573,7 @@ impl Message {
             Message::FingerStatus(m) => m.id(),
             Message::HandHeartbeat(m) => m.id(),
             Message::HandDiag(m) => m.id(),
+            Message::CalibrationCue(m) => m.id(),
         }
     }
 
@@ -4908,6 +5589,7 @@ impl Message {
             Message::FingerStatus(m) => m.name(),
             Message::HandHeartbeat(m) => m.name(),
             Message::HandDiag(m) => m.name(),
+            Message::CalibrationCue(m) => m.name(),
         }
     }
 
@@ -4923,6 +5605,7 @@ impl Message {
             Message::FingerStatus(m) => m.to_frame(),
             Message::HandHeartbeat(m) => m.to_frame(),
             Message::HandDiag(m) => m.to_frame(),
+            Message::CalibrationCue(m) => m.to_frame(),
         }
     }
 
@@ -4938,6 +5621,7 @@ impl Message {
             Message::FingerStatus(m) => m.for_each_signal(f),
             Message::HandHeartbeat(m) => m.for_each_signal(f),
             Message::HandDiag(m) => m.for_each_signal(f),
+            Message::CalibrationCue(m) => m.for_each_signal(f),
         }
     }
 
@@ -4953,6 +5637,7 @@ impl Message {
             Message::FingerStatus(m) => Some(m.e2e()),
             Message::HandHeartbeat(m) => Some(m.e2e()),
             Message::HandDiag(_) => None,
+            Message::CalibrationCue(m) => Some(m.e2e()),
         }
     }
 }
@@ -5271,6 +5956,28 @@ pub const MESSAGES: &[MessageInfo] = &[
             SignalInfo { name: "Label3", start_bit: 50, size: 6, signed: true, factor: 0.05, offset: 0.0, min: -1.0, max: 1.0, raw_min: -20, raw_max: 20, unit: "1", values: &[], comment: "Decoded label of finger 3 (ring)." },
             SignalInfo { name: "Label4", start_bit: 56, size: 6, signed: true, factor: 0.05, offset: 0.0, min: -1.0, max: 1.0, raw_min: -20, raw_max: 20, unit: "1", values: &[], comment: "Decoded label of finger 4 (pinky)." },
             SignalInfo { name: "NewestSample", start_bit: 62, size: 2, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 3.0, raw_min: 0, raw_max: 3, unit: "count", values: &[], comment: "Previous tick: the EMG sample counter of the newest complete sample it had, modulo 4. With TickLatency it names that sample exactly, so a replay of a bus log knows which samples each tick had." },
+        ],
+    },
+    MessageInfo {
+        name: "CALIBRATION_CUE",
+        id: 0x380,
+        dlc: 8,
+        cycle_time_ms: 100,
+        senders: &["TOOL"],
+        receivers: &["HAND", "AMP"],
+        e2e: Some(E2eProfile::from_dbc(0x1380, 4, 8)),
+        comment: "Calibration cue from the technician tool (handctl calibrate) to the patient: what to do now. Sent at 10 Hz and at once on every change of phase, only while a calibration runs. A patient-facing display (AMP side) or the simulated patient follows it; handd ignores it. A receiver that sees no valid cue for 1 s takes the calibration as gone and rests.",
+        signals: &[
+            SignalInfo { name: "Crc", start_bit: 0, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "crc", values: &[], comment: "CRC-8 SAE J1850 over data id 0x1380 and bytes 1..7." },
+            SignalInfo { name: "Counter", start_bit: 8, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 15.0, raw_min: 0, raw_max: 15, unit: "count", values: &[], comment: "4-bit alive counter." },
+            SignalInfo { name: "Phase", start_bit: 12, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 5.0, raw_min: 0, raw_max: 5, unit: "enum", values: &[(0, "IDLE"), (1, "PREPARE"), (2, "HOLD"), (3, "RELAX"), (4, "DONE"), (5, "ABORTED")], comment: "IDLE: no trial yet (or between trials); PREPARE: get ready for the trial named, stay at rest; HOLD: contract now as cued and hold; RELAX: let go, back to rest; DONE: the protocol is finished; ABORTED: the calibration was stopped. Every phase but HOLD means rest." },
+            SignalInfo { name: "Trial", start_bit: 16, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "index", values: &[], comment: "Index of the trial in the protocol (0..254); 255 = none (IDLE, DONE, ABORTED)." },
+            SignalInfo { name: "Finger", start_bit: 24, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 15.0, raw_min: 0, raw_max: 15, unit: "finger", values: &[], comment: "Cued finger: 0 thumb, 1 index, 2 middle, 3 ring, 4 pinky, 5 the whole hand (all five), 15 none (rest). 6..14 are not used; a receiver takes them as none." },
+            SignalInfo { name: "Kind", start_bit: 28, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 2.0, raw_min: 0, raw_max: 2, unit: "enum", values: &[(0, "REST"), (1, "FLEXION"), (2, "EXTENSION")], comment: "REST: stay relaxed; FLEXION: maximal flexion of the cued finger(s) (label +1); EXTENSION: maximal extension (label -1)." },
+            SignalInfo { name: "Repetition", start_bit: 32, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 15.0, raw_min: 0, raw_max: 15, unit: "count", values: &[], comment: "Repetition of this trial's movement in the protocol, 0-based." },
+            SignalInfo { name: "Attempt", start_bit: 36, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 15.0, raw_min: 0, raw_max: 15, unit: "count", values: &[], comment: "Attempt at this trial, 0 = first; a trial repeated after a failed quality check counts up (modulo 16)." },
+            SignalInfo { name: "TimeLeft", start_bit: 40, size: 16, signed: false, factor: 0.01, offset: 0.0, min: 0.0, max: 655.35, raw_min: 0, raw_max: 65535, unit: "s", values: &[], comment: "Time left in the current phase, 0.01 s per LSB (0..655.35 s)." },
+            SignalInfo { name: "Effort", start_bit: 56, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 100.0, raw_min: 0, raw_max: 100, unit: "%", values: &[], comment: "Requested effort in percent of maximal voluntary contraction; 100 for a normal cue." },
         ],
     },
 ];
