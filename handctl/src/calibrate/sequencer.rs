@@ -8,7 +8,7 @@
 
 use super::protocol::{Movement, Protocol};
 
-/// The phase of the cue (hand.dbc's CuePhase).
+/// The phase of the cue (hand.dbc's CuePhase, see [`super::cue`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Phase {
     /// Nothing running yet.
@@ -23,20 +23,6 @@ pub enum Phase {
     Done,
     /// Stopped: interrupted, or a trial failed too often.
     Aborted,
-}
-
-impl Phase {
-    /// The value of hand.dbc's CuePhase.
-    pub fn code(self) -> u8 {
-        match self {
-            Phase::Idle => 0,
-            Phase::Prepare => 1,
-            Phase::Hold => 2,
-            Phase::Relax => 3,
-            Phase::Done => 4,
-            Phase::Aborted => 5,
-        }
-    }
 }
 
 /// What the cue says at one instant.
