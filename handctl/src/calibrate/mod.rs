@@ -31,6 +31,8 @@ pub mod workflow;
 
 #[cfg(test)]
 mod tests;
+// #[cfg(test)]
+// mod mem_test;
 
 use std::io::{BufRead, IsTerminal};
 use std::sync::atomic::AtomicBool;
