@@ -13,8 +13,8 @@ use hand_model::world::{PatientMode, World, WorldConfig};
 use hand_model::{Clock, MemBus, MemEndpoint, VirtualClock};
 
 use super::error::CalibrateError;
-use super::protocol::Protocol;
 use super::output::{Mode, Output};
+use super::protocol::Protocol;
 use super::workflow::{record_session, Pace, Plan, Recorded, Transport};
 
 /// The tool's own endpoint on the in-memory bus.
@@ -121,8 +121,8 @@ fn run(
 fn the_cued_patient_is_calibrated_in_memory_the_weak_trial_repeated_and_a_ctrl_c_resumed() {
     let dir = std::env::temp_dir().join(format!("handctl-calibrate-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    // Ctrl-C 9 s in: trials 1..3 done (3.5 + 3 + 3 s), the 4th running.
-    let first = run(&dir, 1_000_000, Some(10_000_000), false);
+    // Ctrl-C 10 s in: trials 1..3 done (3.5 + 3 + 3 s), the 4th running.
+    let first = run(&dir, 1_000_000, Some(11_000_000), false);
     let Err(CalibrateError::Interrupted { kept, next, .. }) = first else {
         panic!("expected the interruption, got {first:?}")
     };

@@ -72,12 +72,12 @@ impl Output {
 
     /// A new phase began.
     pub fn phase(&mut self, cue: &Cue) {
+        match cue.phase {
+            Phase::Done => return self.say("calibration: every trial recorded"),
+            Phase::Aborted => return self.say("calibration: stopped"),
+            _ => {}
+        }
         let (Some(i), Some(m)) = (cue.trial, cue.movement) else {
-            match cue.phase {
-                Phase::Done => self.say("calibration: every trial recorded"),
-                Phase::Aborted => self.say("calibration: stopped"),
-                _ => {}
-            }
             return;
         };
         let attempt = if cue.attempt > 0 {
@@ -94,11 +94,11 @@ impl Output {
         let secs = cue.time_left_us as f64 / 1e6;
         match cue.phase {
             Phase::Prepare => self.say(&format!(
-                "{head}: get ready: {} in {secs:.0} s",
+                "{head}: get ready: {} in {secs:.1} s",
                 instruction(&m)
             )),
-            Phase::Hold => self.say(&format!("{head}: NOW {} ({secs:.0} s)", instruction(&m))),
-            Phase::Relax => self.say(&format!("{head}: relax ({secs:.0} s)")),
+            Phase::Hold => self.say(&format!("{head}: NOW {} ({secs:.1} s)", instruction(&m))),
+            Phase::Relax => self.say(&format!("{head}: relax ({secs:.1} s)")),
             _ => {}
         }
     }
