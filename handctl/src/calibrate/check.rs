@@ -14,7 +14,7 @@
 
 use std::path::Path;
 
-use decoder::session::{check_gates, GateConfig, Recording, Session, SessionMeta, Trial};
+use decoder::session::{check_gates, GateConfig, GateKind, Recording, Session, SessionMeta, Trial};
 
 use super::error::CalibrateError;
 
@@ -29,16 +29,28 @@ pub fn gate_config() -> GateConfig {
     }
 }
 
-/// The reasons `candidate` fails, empty when it passes. `base` is the session's metadata
-/// (chain, recording) with the trials kept so far; the log in `dir` must be flushed.
+/// The outcome of one attempt's check.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Verdict {
+    /// Why the attempt fails; empty when it passes.
+    pub reasons: Vec<String>,
+    /// Kept repetitions that this attempt shows much weaker than itself (their ids, and why):
+    /// a weak first repetition is only seen when a stronger one follows.
+    pub weaker_kept: Vec<(u32, String)>,
+}
+
+/// The check of `candidate`. `base` is the session's metadata (chain, recording) with the
+/// trials kept so far; the log in `dir` must be flushed.
 pub fn check_trial(
     dir: &Path,
     base: &SessionMeta,
     candidate: Trial,
-) -> Result<Vec<String>, CalibrateError> {
+) -> Result<Verdict, CalibrateError> {
+    // A redone trial replaces its kept attempt, so that one is left out.
     let related = |t: &&Trial| {
-        t.kind == decoder::session::TrialKind::Rest
-            || (t.kind == candidate.kind && t.finger == candidate.finger)
+        t.id != candidate.id
+            && (t.kind == decoder::session::TrialKind::Rest
+                || (t.kind == candidate.kind && t.finger == candidate.finger))
     };
     let mut meta = base.clone();
     meta.trials = base.trials.iter().filter(related).copied().collect();
@@ -46,10 +58,13 @@ pub fn check_trial(
     let recording = Recording::load(&meta, dir)?;
     let session = Session::from_parts(dir.to_path_buf(), meta, recording)?;
     let report = check_gates(&session, &gate_config())?;
-    Ok(report
-        .issues
-        .into_iter()
-        .filter(|i| i.trial_id == candidate.id)
-        .map(|i| i.message)
-        .collect())
+    let mut v = Verdict::default();
+    for i in report.issues {
+        if i.trial_id == candidate.id {
+            v.reasons.push(i.message);
+        } else if i.kind == GateKind::WeakRepetition {
+            v.weaker_kept.push((i.trial_id, i.message));
+        }
+    }
+    Ok(v)
 }

@@ -75,6 +75,8 @@ pub struct Sequencer {
     phase_start_us: u64,
     hold_start_us: u64,
     awaiting_check: bool,
+    /// While an earlier trial is redone: the trial to go on with after it.
+    resume_at: Option<usize>,
 }
 
 impl Sequencer {
@@ -89,6 +91,7 @@ impl Sequencer {
             phase_start_us: now_us,
             hold_start_us: now_us,
             awaiting_check: false,
+            resume_at: None,
             trials,
         };
         s.phase = if first < s.trials.len() {
@@ -189,7 +192,7 @@ impl Sequencer {
     pub fn passed(&mut self, now_us: u64) -> Event {
         self.awaiting_check = false;
         self.attempt = 0;
-        self.index += 1;
+        self.index = self.resume_at.take().unwrap_or(self.index + 1);
         let next = if self.index < self.trials.len() {
             Phase::Prepare
         } else {
@@ -206,6 +209,17 @@ impl Sequencer {
             return self.abort(now_us);
         }
         self.attempt += 1;
+        self.enter(Phase::Prepare, now_us)
+            .expect("enter gives an event")
+    }
+
+    /// The checked trial passed, but showed that the earlier trial `earlier` (kept) was much
+    /// weaker than it: redo `earlier` now (its next attempt), then go on after this one.
+    pub fn passed_then_redo(&mut self, now_us: u64, earlier: usize) -> Event {
+        self.awaiting_check = false;
+        self.resume_at = Some(self.resume_at.unwrap_or(self.index + 1));
+        self.index = earlier;
+        self.attempt = 1;
         self.enter(Phase::Prepare, now_us)
             .expect("enter gives an event")
     }
@@ -274,5 +288,36 @@ mod tests {
         };
         assert_eq!(c.phase, Phase::Aborted);
         assert!(s.finished());
+    }
+
+    #[test]
+    fn an_earlier_trial_is_redone_then_the_protocol_goes_on() {
+        let p = Protocol::parse(
+            "repetitions = 2\nfingers = [\"index\"]\nkinds = [\"flexion\"]",
+            "t",
+        )
+        .expect("valid");
+        let mut s = Sequencer::new(&p, 0, 0);
+        let mut now = 0;
+        let mut run = |s: &mut Sequencer| {
+            now += 100_000_000;
+            drain(s, now);
+            now
+        };
+        let t = run(&mut s);
+        s.passed(t);
+        let t = run(&mut s);
+        s.passed(t);
+        let t = run(&mut s);
+        // Trial 3 (round 2's rest) passed, and showed trial 1 weak: trial 1 again, attempt 2.
+        let Event::Phase(c) = s.passed_then_redo(t, 1) else {
+            panic!()
+        };
+        assert_eq!((c.trial, c.attempt), (Some(1), 1));
+        let t = run(&mut s);
+        let Event::Phase(c) = s.passed(t) else {
+            panic!()
+        };
+        assert_eq!((c.trial, c.attempt), (Some(3), 0));
     }
 }

@@ -111,9 +111,13 @@ impl Store {
         self.meta.trials.len()
     }
 
-    /// Keeps a passing trial and rewrites `session.toml` atomically.
+    /// Keeps a passing trial (replacing a kept one of the same id: a redone trial) and
+    /// rewrites `session.toml` atomically.
     pub fn keep(&mut self, trial: Trial) -> Result<(), CalibrateError> {
-        self.meta.trials.push(trial);
+        match self.meta.trials.iter_mut().find(|t| t.id == trial.id) {
+            Some(old) => *old = trial,
+            None => self.meta.trials.push(trial),
+        }
         self.meta.write(&self.dir)?;
         Ok(())
     }

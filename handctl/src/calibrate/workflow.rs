@@ -221,7 +221,8 @@ impl<T: Transport> Run<'_, T> {
             end_us,
         };
         self.rec.flush()?;
-        let reasons = check_trial(self.store.dir(), &self.store.meta, trial)?;
+        let verdict = check_trial(self.store.dir(), &self.store.meta, trial)?;
+        let reasons = verdict.reasons;
         self.out.verdict(&trial, hold.attempt, reaction, &reasons);
         if reasons.is_empty() {
             if trial.kind == TrialKind::Rest {
@@ -230,7 +231,7 @@ impl<T: Transport> Run<'_, T> {
             }
             self.done.reactions_us.extend(reaction);
             self.store.keep(trial)?;
-            return Ok(self.seq.passed(now));
+            return Ok(self.after_pass(verdict.weaker_kept, now));
         }
         self.done.repeats.push(Repeat {
             trial,
@@ -248,5 +249,23 @@ impl<T: Transport> Run<'_, T> {
             });
         }
         Ok(ev)
+    }
+
+    /// The next event after a kept attempt: the next trial, or first a kept repetition this
+    /// attempt showed much weaker (a weak first repetition is only seen against a later one).
+    fn after_pass(&mut self, weaker: Vec<(u32, String)>, now: u64) -> Event {
+        let Some((id, why)) = weaker.into_iter().next() else {
+            return self.seq.passed(now);
+        };
+        let Some(old) = self.store.meta.trials.iter().find(|t| t.id == id).copied() else {
+            return self.seq.passed(now);
+        };
+        self.out.verdict(&old, 0, None, std::slice::from_ref(&why));
+        self.done.repeats.push(Repeat {
+            trial: old,
+            attempt: 0,
+            reasons: vec![why],
+        });
+        self.seq.passed_then_redo(now, id as usize - 1)
     }
 }
