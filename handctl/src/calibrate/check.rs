@@ -12,9 +12,11 @@
 //! 0.5 threshold would let through on a noisy day, while honest maximal repetitions stay
 //! within about 20 % of each other.
 
-use std::path::Path;
+use std::path::PathBuf;
 
-use decoder::session::{check_gates, GateConfig, GateKind, Recording, Session, SessionMeta, Trial};
+use decoder::session::{
+    check_gates, GateConfig, GateKind, Recording, Segment, Session, SessionMeta, Trial,
+};
 
 use super::error::CalibrateError;
 
@@ -39,24 +41,34 @@ pub struct Verdict {
     pub weaker_kept: Vec<(u32, String)>,
 }
 
-/// The check of `candidate`. `base` is the session's metadata (chain, recording) with the
-/// trials kept so far; the log in `dir` must be flushed.
+/// Filter warm-up before each trial in the check's recording, µs (the band-pass and notch
+/// settle well within it).
+pub const WARMUP_US: u64 = 1_000_000;
+
+/// The check of `candidate` on `recording` (the EMG of this run, in memory). `base` is the
+/// session's metadata (chain, recording) with the trials kept so far. Only the stretches of
+/// the trials compared are checked, each from [`WARMUP_US`] before it as a segment of its
+/// own, so a check costs the same at the end of a long calibration as at its start.
 pub fn check_trial(
-    dir: &Path,
+    recording: &Recording,
     base: &SessionMeta,
     candidate: Trial,
 ) -> Result<Verdict, CalibrateError> {
-    // A redone trial replaces its kept attempt, so that one is left out.
+    // A redone trial replaces its kept attempt, so that one is left out; a trial older than
+    // the recording (none: a resumed run starts from the old log) could not be compared.
+    let first = recording.time_us.first().copied().unwrap_or(u64::MAX);
     let related = |t: &&Trial| {
         t.id != candidate.id
+            && t.start_us >= first
             && (t.kind == decoder::session::TrialKind::Rest
                 || (t.kind == candidate.kind && t.finger == candidate.finger))
     };
     let mut meta = base.clone();
     meta.trials = base.trials.iter().filter(related).copied().collect();
     meta.trials.push(candidate);
-    let recording = Recording::load(&meta, dir)?;
-    let session = Session::from_parts(dir.to_path_buf(), meta, recording)?;
+    let (segments, part) = stretches(recording, &meta.trials);
+    meta.segments = segments;
+    let session = Session::from_parts(PathBuf::from("(this calibration)"), meta, part)?;
     let report = check_gates(&session, &gate_config())?;
     let mut v = Verdict::default();
     for i in report.issues {
@@ -67,4 +79,46 @@ pub fn check_trial(
         }
     }
     Ok(v)
+}
+
+/// The stretches of `r` holding `trials` (each from [`WARMUP_US`] before it, overlapping
+/// ones merged) as segments, and a recording of those samples alone.
+fn stretches(r: &Recording, trials: &[Trial]) -> (Vec<Segment>, Recording) {
+    let mut spans: Vec<(u64, u64)> = trials
+        .iter()
+        .map(|t| (t.start_us.saturating_sub(WARMUP_US), t.end_us))
+        .collect();
+    spans.sort_unstable();
+    let mut merged: Vec<Segment> = Vec::new();
+    for (s, e) in spans {
+        match merged.last_mut() {
+            Some(m) if s <= m.end_us => m.end_us = m.end_us.max(e),
+            _ => merged.push(Segment {
+                start_us: s,
+                end_us: e,
+            }),
+        }
+    }
+    let mut part = Recording {
+        channels: r.channels,
+        samples: Vec::new(),
+        time_us: Vec::new(),
+        lost_samples: r.lost_samples,
+        breaks: Vec::new(),
+        bad_frames: r.bad_frames,
+        unit_per_raw: r.unit_per_raw,
+    };
+    for seg in &merged {
+        let range = r.range_of(seg.start_us, seg.end_us);
+        let base = part.time_us.len();
+        part.breaks.extend(
+            r.breaks
+                .iter()
+                .filter(|&&b| b > range.start && b < range.end)
+                .map(|&b| b - range.start + base),
+        );
+        part.samples.extend_from_slice(r.slice(range.clone()));
+        part.time_us.extend_from_slice(&r.time_us[range]);
+    }
+    (merged, part)
 }

@@ -10,7 +10,7 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use decoder::dsp::ChainConfig;
-use decoder::session::{Trial, TrialKind};
+use decoder::session::{Recording, Trial, TrialKind};
 use hand_dbc::CanFrame;
 
 use super::check::check_trial;
@@ -115,7 +115,12 @@ pub fn record_session(
         (Store::create(&plan.dir, plan.chain.clone(), &p)?, p)
     };
     let settings = plan.chain.validate()?;
-    let rec = Recorder::open(&plan.dir, &plan.iface, &settings, plan.resume)?;
+    let resumed = if plan.resume {
+        Some(old_recording(&store)?)
+    } else {
+        None
+    };
+    let rec = Recorder::open(&plan.dir, &plan.iface, &settings, resumed)?;
     let now = clock.now_us();
     let seq = Sequencer::new(&protocol, store.kept(), now);
     let mut run = Run {
@@ -140,6 +145,26 @@ pub fn record_session(
     run.done.kept = run.store.kept();
     run.done.frames = run.rec.frames();
     Ok(run.done)
+}
+
+/// The EMG of the log a resumed calibration continues (empty when the log holds none).
+fn old_recording(store: &Store) -> Result<Recording, CalibrateError> {
+    let path = store.meta.recording_path(store.dir());
+    match Recording::load(&store.meta, store.dir()) {
+        Ok(r) => Ok(r),
+        Err(_) if !path.exists() || std::fs::metadata(&path).is_ok_and(|m| m.len() == 0) => {
+            Ok(Recording {
+                channels: store.meta.chain.channels,
+                samples: Vec::new(),
+                time_us: Vec::new(),
+                lost_samples: 0,
+                breaks: Vec::new(),
+                bad_frames: 0,
+                unit_per_raw: hand_dbc::emg::EMG_LSB_UV,
+            })
+        }
+        Err(e) => Err(e.into()),
+    }
 }
 
 impl<T: Transport> Run<'_, T> {
@@ -221,7 +246,7 @@ impl<T: Transport> Run<'_, T> {
             end_us,
         };
         self.rec.flush()?;
-        let verdict = check_trial(self.store.dir(), &self.store.meta, trial)?;
+        let verdict = check_trial(self.rec.recording(), &self.store.meta, trial)?;
         let reasons = verdict.reasons;
         self.out.verdict(&trial, hold.attempt, reaction, &reasons);
         if reasons.is_empty() {
