@@ -8,7 +8,8 @@ use decoder::session::{SessionMeta, Trial, TrialTable};
 use crate::emg::{AmplifierConfig, ADC_MAX, N_CHANNELS};
 use crate::error::SimError;
 use crate::patient::{
-    CalibrationProtocol, ClosedLoopUser, Gesture, Intent, Script, Target, TrackingConfig,
+    CalibrationProtocol, ClosedLoopUser, CuedConfig, Gesture, Intent, Script, Target,
+    TrackingConfig,
 };
 use crate::world::PatientMode;
 
@@ -28,17 +29,25 @@ pub enum Scenario {
     Gestures,
     /// Slow ramps of the whole hand from rest to full flexion and to full extension, 20 s.
     Ramps,
+    /// The patient follows the CALIBRATION_CUE frames on the bus (`handctl calibrate`), with
+    /// a human reaction delay; rests while no cue arrives. 30 min.
+    Cued,
 }
+
+/// How long the cued scenario runs unless told otherwise: longer than a calibration with
+/// repeats, µs.
+pub const CUED_DURATION_US: u64 = 30 * 60 * 1_000_000;
 
 impl Scenario {
     /// Every scenario.
-    pub const ALL: [Scenario; 6] = [
+    pub const ALL: [Scenario; 7] = [
         Scenario::Rest,
         Scenario::Calibration,
         Scenario::CalibrationQuick,
         Scenario::Sine,
         Scenario::Gestures,
         Scenario::Ramps,
+        Scenario::Cued,
     ];
 
     /// The command-line name.
@@ -50,6 +59,7 @@ impl Scenario {
             Scenario::Sine => "sine",
             Scenario::Gestures => "gestures",
             Scenario::Ramps => "ramps",
+            Scenario::Cued => "cued",
         }
     }
 
@@ -66,10 +76,15 @@ impl Scenario {
             }
             Scenario::Gestures => "fist, open, pinch, point, thumbs-up, held 2 s each, twice",
             Scenario::Ramps => "whole hand ramps rest -> full flexion -> rest -> full extension, 20 s",
+            Scenario::Cued => {
+                "follows CALIBRATION_CUE on the bus (handctl calibrate), 250-450 ms reaction; \
+                 rests without cues; 30 min"
+            }
         }
     }
 
-    /// Builds the scenario; `seed` seeds the closed-loop user's motor noise.
+    /// Builds the scenario; `seed` seeds the closed-loop user's motor noise and the cued
+    /// patient's reaction delays (see [`ScenarioRun::cued`] for other cued settings).
     pub fn build(self, seed: u64) -> Result<ScenarioRun, SimError> {
         let scripted = |script: Script| {
             let duration_us = script.duration_us();
@@ -121,6 +136,10 @@ impl Scenario {
                     .rest(2_000_000);
                 scripted(s)
             }
+            Scenario::Cued => ScenarioRun::cued(CuedConfig {
+                seed,
+                ..CuedConfig::default()
+            })?,
         })
     }
 
@@ -155,6 +174,17 @@ pub struct ScenarioRun {
 }
 
 impl ScenarioRun {
+    /// The cued scenario with these settings (e.g. a [`CuedConfig::weak_trial`]): runs
+    /// [`CUED_DURATION_US`], no trials of its own (the cues' sender knows them).
+    pub fn cued(cfg: CuedConfig) -> Result<Self, SimError> {
+        Ok(Self {
+            scenario: Scenario::Cued,
+            patient: PatientMode::cued(cfg)?,
+            duration_us: CUED_DURATION_US,
+            trials: Vec::new(),
+        })
+    }
+
     /// The trials as TOML `[[trial]]` tables (the session.toml form of contracts.md).
     pub fn trials_toml(&self) -> String {
         TrialTable {

@@ -12,7 +12,7 @@ use crate::finger::{FingerConfig, N_FINGERS};
 use crate::nodes::{
     std_id, AmplifierNode, AmplifierNodeConfig, Bus, FaultInjector, FingerNode, NodeStats,
 };
-use crate::patient::{ClosedLoopUser, Intent, Script};
+use crate::patient::{ClosedLoopUser, CuedConfig, CuedPatient, Intent, Script};
 
 /// Who decides the patient's intent.
 #[derive(Debug, Clone)]
@@ -21,6 +21,15 @@ pub enum PatientMode {
     Script(Script),
     /// A closed-loop user tracking a target with one finger.
     ClosedLoop(Box<ClosedLoopUser>),
+    /// A patient following the CALIBRATION_CUE frames on the bus (rests without them).
+    Cued(Box<CuedPatient>),
+}
+
+impl PatientMode {
+    /// A cued patient with these settings (checked).
+    pub fn cued(cfg: CuedConfig) -> Result<Self, SimError> {
+        Ok(PatientMode::Cued(Box::new(CuedPatient::try_new(cfg)?)))
+    }
 }
 
 /// The simulated world.
@@ -114,18 +123,23 @@ impl<B: Bus> World<B> {
     pub fn step(&mut self, now_us: u64) {
         let rel = now_us.saturating_sub(self.start_us);
         while let Some(frame) = self.patient_stats.receive(&mut self.patient_bus) {
-            if let PatientMode::ClosedLoop(user) = &mut self.patient {
-                let id = std_id(&frame);
-                if FingerStatus::instance_of(id) == Some(user.config().finger) {
-                    if let Ok(st) = FingerStatus::decode(id, frame.data()) {
-                        user.observe(rel, st.force());
+            match &mut self.patient {
+                PatientMode::ClosedLoop(user) => {
+                    let id = std_id(&frame);
+                    if FingerStatus::instance_of(id) == Some(user.config().finger) {
+                        if let Ok(st) = FingerStatus::decode(id, frame.data()) {
+                            user.observe(rel, st.force());
+                        }
                     }
                 }
+                PatientMode::Cued(p) => p.observe(rel, &frame),
+                PatientMode::Script(_) => {}
             }
         }
         self.intent = match &mut self.patient {
             PatientMode::Script(s) => s.intent_at(rel),
             PatientMode::ClosedLoop(u) => u.intent_at(rel),
+            PatientMode::Cued(p) => p.intent_at(rel),
         };
         if let Some((amp, bus)) = &mut self.amp {
             amp.set_intent(self.intent);
@@ -140,6 +154,11 @@ impl<B: Bus> World<B> {
     /// The intent the patient had at the last step.
     pub fn intent(&self) -> Intent {
         self.intent
+    }
+
+    /// The patient (e.g. a cued patient's [`CuedPatient::stats`]).
+    pub fn patient(&self) -> &PatientMode {
+        &self.patient
     }
 
     /// The amplifier node, if it runs.

@@ -114,9 +114,46 @@ fn bad_arguments_are_refused() {
         vec!["--mem", "--fingers", "7"],
         vec!["--scenario", "rest"],
         vec!["--session-out", "/tmp/x", "--scenario", "rest"],
+        vec!["--mem", "--scenario", "cued", "--weak-trial", "255"],
+        vec!["--mem", "--scenario", "cued", "--weak-trial", "-1"],
     ] {
         let out = handsim(&args);
         assert!(!out.status.success(), "{args:?} accepted");
         assert!(!out.stderr.is_empty(), "{args:?}: no message");
     }
+}
+
+#[test]
+fn cued_scenario_rests_without_cues_and_takes_a_weak_trial_only_when_cued() {
+    let out = handsim(&[
+        "--mem",
+        "--scenario",
+        "cued",
+        "--duration",
+        "0.5",
+        "--weak-trial",
+        "3",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("scenario cued") && text.contains("0x0100        501"),
+        "{text}"
+    );
+    let out = handsim(&["--mem", "--scenario", "rest", "--weak-trial", "3"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--weak-trial") && err.contains("cued"),
+        "{err}"
+    );
+    let help = String::from_utf8_lossy(&handsim(&["--help"]).stdout).into_owned();
+    assert!(
+        help.contains("--weak-trial") && help.contains("CALIBRATION_CUE"),
+        "{help}"
+    );
 }

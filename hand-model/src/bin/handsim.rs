@@ -13,14 +13,30 @@ use hand_model::emg::AmplifierConfig;
 use hand_model::faults::{Fault, FaultPlan};
 use hand_model::finger::FingerConfig;
 use hand_model::nodes::{AmplifierNodeConfig, Bus};
+use hand_model::patient::CuedConfig;
 use hand_model::record::run_on_mem_bus;
-use hand_model::scenario::Scenario;
+use hand_model::scenario::{Scenario, ScenarioRun};
 use hand_model::socketcan_bus::SocketCanBus;
 use hand_model::world::{NodeSelection, World, WorldConfig};
 use hand_model::SimError;
 
+/// After the options in `handsim --help`.
+const AFTER_HELP: &str = "\
+Scenario cued (the simulated patient of `handctl calibrate`): the patient reads CALIBRATION_CUE
+frames (0x380, E2E-valid only) from the bus and acts on them like a person: after a reaction
+delay of 250-450 ms (seeded by --seed) it contracts the cued finger, or the whole hand, in the
+cued direction at the cued effort while the phase is HOLD (reaching it within 200 ms more), and
+lets go (over 500 ms) on RELAX, PREPARE, IDLE, DONE or ABORTED. Without a valid cue for 1 s it
+rests; with none at all it rests for the whole run (30 min unless --duration). E.g. beside
+handd:  handsim --iface vcan0 --scenario cued --weak-trial 3";
+
 #[derive(Parser, Debug)]
-#[command(name = "handsim", version, about = "The simulated hand on a CAN bus")]
+#[command(
+    name = "handsim",
+    version,
+    about = "The simulated hand on a CAN bus",
+    after_help = AFTER_HELP
+)]
 struct Args {
     /// SocketCAN interface to run on in real time (e.g. vcan0).
     #[arg(long, conflicts_with = "mem")]
@@ -57,6 +73,11 @@ struct Args {
     /// session.toml with the trials), ready for decoder::session.
     #[arg(long, requires = "mem")]
     session_out: Option<std::path::PathBuf>,
+    /// With --scenario cued: hold the first attempt (cue Attempt 0) of trial N (the cue's
+    /// Trial index, 0..254) at 50% effort whatever the cue asks, once, so that a calibration's
+    /// quality check can catch it and repeat the trial (later attempts are full).
+    #[arg(long, value_name = "N")]
+    weak_trial: Option<u8>,
     /// List the scenarios and faults, then exit.
     #[arg(long)]
     list_scenarios: bool,
@@ -108,6 +129,22 @@ fn parse_fingers(s: &str) -> Result<u8, SimError> {
     Ok(mask)
 }
 
+/// The scenario, with the cued patient's options from the command line.
+fn build(scenario: Scenario, args: &Args) -> Result<ScenarioRun, SimError> {
+    match (scenario, args.weak_trial) {
+        (_, None) => scenario.build(args.seed),
+        (Scenario::Cued, Some(n)) => ScenarioRun::cued(CuedConfig {
+            seed: args.seed,
+            weak_trial: Some(n),
+            ..CuedConfig::default()
+        }),
+        (_, Some(_)) => Err(SimError::BadScript(format!(
+            "--weak-trial applies to --scenario cued only, not {}",
+            scenario.name()
+        ))),
+    }
+}
+
 fn run() -> Result<(), String> {
     let args = Args::parse();
     if args.list_scenarios {
@@ -121,7 +158,7 @@ fn run() -> Result<(), String> {
         return Ok(());
     }
     let scenario: Scenario = args.scenario.parse().map_err(|e: SimError| e.to_string())?;
-    let run = scenario.build(args.seed).map_err(|e| e.to_string())?;
+    let run = build(scenario, &args).map_err(|e| e.to_string())?;
     let duration_us = match args.duration {
         Some(d) if d.is_finite() && d > 0.0 => (d * 1e6).round() as u64,
         Some(d) => {
