@@ -29,9 +29,8 @@ pub mod summary;
 pub mod training;
 pub mod workflow;
 
-// Enabled when branch `cue`'s cued patient is merged (it needs hand_model::patient::CuedConfig).
-// #[cfg(test)]
-// mod mem_test;
+#[cfg(test)]
+mod mem_test;
 #[cfg(test)]
 mod tests;
 
