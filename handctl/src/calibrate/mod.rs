@@ -35,7 +35,7 @@ mod mem_test;
 mod tests;
 
 use std::io::{BufRead, IsTerminal};
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 
 use decoder::dsp::ChainConfig;
@@ -74,14 +74,12 @@ pub fn run(a: &CalibrateArgs) -> Result<(), CliError> {
     };
     let trials = protocol.clone().unwrap_or_default().trials().len();
     let mut out = Output::new(mode, trials);
+    let mut bus = socket::SocketBus::open(&a.iface)?;
     hold_hand(a, &mut out)?;
     if !a.yes {
         confirm(&mut out)?;
     }
-    let stop = Arc::new(AtomicBool::new(false));
-    signal_hook::flag::register(signal_hook::consts::SIGINT, Arc::clone(&stop))
-        .map_err(|e| CliError::Usage(format!("cannot catch Ctrl-C: {e}")))?;
-    let mut bus = socket::SocketBus::open(&a.iface)?;
+    let stop = catch_ctrl_c()?;
     let plan = Plan {
         protocol,
         dir: a.out.clone(),
@@ -90,6 +88,8 @@ pub fn run(a: &CalibrateArgs) -> Result<(), CliError> {
         resume: a.resume,
     };
     let done = workflow::record_session(&mut bus, &mut socket::WallClock, &plan, &mut out, &stop)?;
+    // From here on Ctrl-C ends the process at once (the model file is written atomically).
+    stop.store(true, Ordering::Relaxed);
     out.say(&format!(
         "session: {} trials kept in {} ({} frames logged, {} attempt(s) repeated); training",
         done.kept,
@@ -103,6 +103,18 @@ pub fn run(a: &CalibrateArgs) -> Result<(), CliError> {
         summary::render(&trained, &summary::summarize(&trained))
     );
     Ok(())
+}
+
+/// Ctrl-C: while the flag is down the first one raises it (the recording stops cleanly and
+/// keeps what is done); once it is up, Ctrl-C ends the process.
+fn catch_ctrl_c() -> Result<Arc<AtomicBool>, CliError> {
+    use signal_hook::consts::SIGINT;
+    let stop = Arc::new(AtomicBool::new(false));
+    let bad = |e: std::io::Error| CliError::Usage(format!("cannot catch Ctrl-C: {e}"));
+    signal_hook::flag::register_conditional_shutdown(SIGINT, 130, Arc::clone(&stop))
+        .map_err(bad)?;
+    signal_hook::flag::register(SIGINT, Arc::clone(&stop)).map_err(bad)?;
+    Ok(stop)
 }
 
 /// Asks a running handd to hold the hand; says clearly when none runs.
