@@ -137,6 +137,14 @@ fn the_cued_patient_is_calibrated_in_memory_the_weak_trial_repeated_and_a_ctrl_c
     let weak = &done.repeats[0];
     assert_eq!((weak.trial.id, weak.attempt), (u32::from(WEAK) + 1, 0));
     assert!(weak.reasons[0].contains("only"), "{:?}", weak.reasons);
+    println!("caught: {}", weak.reasons[0]);
+    println!(
+        "reactions measured, ms: {:?}",
+        done.reactions_us
+            .iter()
+            .map(|r| r / 1000)
+            .collect::<Vec<_>>()
+    );
     let session = Session::open(&dir).expect("the session");
     let ids: Vec<u32> = session.meta.trials.iter().map(|t| t.id).collect();
     assert_eq!(ids, (1..=10).collect::<Vec<_>>());
@@ -196,6 +204,7 @@ fn train_and_summarize(dir: &Path) {
     assert!(index.reach > 0.5, "{index:?}");
     assert_eq!(fingers[0].windows, 0, "the thumb was not in the protocol");
     let text = super::summary::render(&trained, &fingers);
+    println!("{text}");
     assert!(
         text.contains("handctl deploy") && text.contains("handctl arm"),
         "{text}"
