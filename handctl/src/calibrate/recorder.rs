@@ -41,6 +41,19 @@ pub struct Recorder {
     recording: Recording,
 }
 
+/// A bus recording of `channels` channels with no sample yet (µV per LSB as the bus's).
+pub fn empty_recording(channels: usize) -> Recording {
+    Recording {
+        channels,
+        samples: Vec::new(),
+        time_us: Vec::new(),
+        lost_samples: 0,
+        breaks: Vec::new(),
+        bad_frames: 0,
+        unit_per_raw: EMG_LSB_UV,
+    }
+}
+
 /// Appends one front-end sample to `r` (as `decoder::session`'s candump loader does: a gap
 /// is a break, times never step back).
 fn push_sample(r: &mut Recording, s: &FrontSample) {
@@ -82,15 +95,7 @@ impl Recorder {
         Ok(Recorder {
             front: EmgFront::new(&front),
             recording: resumed.map_or_else(
-                || Recording {
-                    channels: settings.n_channels(),
-                    samples: Vec::new(),
-                    time_us: Vec::new(),
-                    lost_samples: 0,
-                    breaks: Vec::new(),
-                    bad_frames: 0,
-                    unit_per_raw: EMG_LSB_UV,
-                },
+                || empty_recording(settings.n_channels()),
                 |mut r| {
                     r.breaks.push(r.time_us.len());
                     r

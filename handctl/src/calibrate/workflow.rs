@@ -153,15 +153,7 @@ fn old_recording(store: &Store) -> Result<Recording, CalibrateError> {
     match Recording::load(&store.meta, store.dir()) {
         Ok(r) => Ok(r),
         Err(_) if !path.exists() || std::fs::metadata(&path).is_ok_and(|m| m.len() == 0) => {
-            Ok(Recording {
-                channels: store.meta.chain.channels,
-                samples: Vec::new(),
-                time_us: Vec::new(),
-                lost_samples: 0,
-                breaks: Vec::new(),
-                bad_frames: 0,
-                unit_per_raw: hand_dbc::emg::EMG_LSB_UV,
-            })
+            Ok(super::recorder::empty_recording(store.meta.chain.channels))
         }
         Err(e) => Err(e.into()),
     }
