@@ -54,6 +54,10 @@ pub enum Command {
     Monitor(MonitorArgs),
     /// Record a CAN bus to DIR/frames.log (candump) and, with handsim's trials, a session.
     Record(RecordArgs),
+    /// The guided calibration of a patient: cues (terminal and bus), recording, a check of
+    /// every trial (a failing one repeated at once), training, verification and a summary;
+    /// writes DIR/session.toml, DIR/frames.log and DIR/model.hsm.
+    Calibrate(CalibrateArgs),
     /// The whole system in one process: calibrate the simulated patient, train ResDD, drive
     /// the simulated hand while the patient tracks a sine, and score the tracking (needs a
     /// handctl built with the `sim` feature).
@@ -447,4 +451,34 @@ pub struct DecodeArgs {
     /// Print the agreement as JSON (exact numbers) instead of a table.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `handctl calibrate`.
+#[derive(Debug, Args)]
+pub struct CalibrateArgs {
+    /// SocketCAN interface of the hand's bus, e.g. can0 or vcan0.
+    #[arg(long)]
+    pub iface: String,
+    /// Output directory: frames.log, protocol.toml, session.toml, model.hsm.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Protocol TOML (trials, repetitions, phase times); default: the built-in protocol.
+    #[arg(long)]
+    pub protocol: Option<PathBuf>,
+    /// No questions; plain progress lines instead of the live screen.
+    #[arg(long)]
+    pub yes: bool,
+    /// Continue an interrupted calibration in --out from its next trial.
+    #[arg(long)]
+    pub resume: bool,
+    /// Mains frequency written into the session's chain settings, 50 or 60 Hz.
+    #[arg(long, default_value_t = 50, value_parser = parse_mains)]
+    pub mains: u32,
+    /// A trained model reversing beyond this on a calibration ray is refused (label units).
+    #[arg(long, default_value_t = decoder::model::verify::DEFAULT_TOLERANCE, value_parser = parse_tolerance)]
+    pub tolerance: f64,
+    #[command(flatten)]
+    pub daemon: DaemonOpts,
+    #[command(flatten)]
+    pub training: TrainingOpts,
 }

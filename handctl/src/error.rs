@@ -76,6 +76,9 @@ pub enum CliError {
     /// A model could not be put together (e.g. a record that contradicts itself).
     #[error("model: {0}")]
     Model(#[from] decoder::model::ModelError),
+    /// The guided calibration stopped.
+    #[error("calibrate: {0}")]
+    Calibrate(#[from] crate::calibrate::error::CalibrateError),
     /// The command cannot do what was asked with this data.
     #[error("{0}")]
     Usage(String),

@@ -11,6 +11,7 @@
 //! figures with the `plots` feature, and writes the curves as CSV without it.
 
 mod args;
+mod calibrate;
 mod daemon;
 mod decode;
 #[cfg(feature = "sim")]
@@ -53,6 +54,7 @@ fn main() -> ExitCode {
         Command::Rollback(o) => deploy::rollback(o),
         Command::Monitor(a) => monitor::run(a),
         Command::Record(a) => record::run(a),
+        Command::Calibrate(a) => calibrate::run(a),
         Command::Demo(a) => run_demo(a),
     };
     match result {

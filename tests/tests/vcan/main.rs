@@ -6,6 +6,7 @@
 //! Times are kernel receive timestamps of a monitor socket; handsim's scenario time 0 is the
 //! receive time of its first EMG sample (counter 0), so fault onsets are placed on the bus.
 
+mod calibrate;
 mod deploy;
 mod epoch;
 mod monitor_tui;

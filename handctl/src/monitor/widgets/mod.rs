@@ -6,7 +6,7 @@ mod daemon;
 mod fingers;
 mod plot;
 
-pub use channels::ChannelBars;
+pub use channels::{bar_cells, ChannelBars};
 pub use daemon::{Baseline, DaemonPanel};
 pub use fingers::FingerTable;
 pub use plot::FingerPlot;
