@@ -4,15 +4,10 @@
 //! follows. Behind a small trait ([`DaemonLink`]) so that the rest of the calibration does not
 //! depend on how the request travels.
 
-use std::io::{BufRead, BufReader, Write};
-use std::os::unix::net::UnixStream;
-use std::path::{Path, PathBuf};
-use std::time::Duration;
+use std::path::PathBuf;
 
-use driver::protocol::Reply;
-
-/// How long to wait for handd's reply.
-const REPLY_WAIT: Duration = Duration::from_secs(5);
+use driver::control::{request, ControlError};
+use driver::protocol::{Reply, Request};
 
 /// What handd said to the calibrating request.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -42,38 +37,27 @@ impl DaemonLink for SocketLink {
         if !self.path.exists() {
             return Ok(HoldOutcome::NoDaemon(self.path.clone()));
         }
-        let reply = match ask(&self.path, r#"{"cmd":"calibrating"}"#) {
-            Ok(r) => r,
-            Err(e) if e.kind() == std::io::ErrorKind::ConnectionRefused => {
-                return Ok(HoldOutcome::NoDaemon(self.path.clone()))
+        match request(&self.path, &Request::Calibrating) {
+            Ok(reply) => read_reply(reply),
+            Err(ControlError::Connect { source, .. })
+                if source.kind() == std::io::ErrorKind::ConnectionRefused =>
+            {
+                Ok(HoldOutcome::NoDaemon(self.path.clone()))
             }
-            Err(e) => return Err(format!("{}: {e}", self.path.display())),
-        };
-        parse_reply(&reply)
+            Err(e) => Err(e.to_string()),
+        }
     }
 }
 
-/// One request line and the reply line.
-fn ask(path: &Path, line: &str) -> std::io::Result<String> {
-    let mut s = UnixStream::connect(path)?;
-    s.set_read_timeout(Some(REPLY_WAIT))?;
-    s.write_all(line.as_bytes())?;
-    s.write_all(b"\n")?;
-    let mut reply = String::new();
-    BufReader::new(&s).read_line(&mut reply)?;
-    Ok(reply)
-}
-
-/// handd's reply, as `driver::protocol::Reply`.
-fn parse_reply(reply: &str) -> Result<HoldOutcome, String> {
-    match serde_json::from_str::<Reply>(reply.trim()) {
-        Ok(Reply::Ok { message, .. }) => Ok(HoldOutcome::Held(message)),
-        Ok(Reply::Refused { reason }) => Err(format!(
+/// What handd's reply means for the calibration.
+fn read_reply(reply: Reply) -> Result<HoldOutcome, String> {
+    match reply {
+        Reply::Ok { message, .. } => Ok(HoldOutcome::Held(message)),
+        Reply::Refused { reason } => Err(format!(
             "handd refused to hold the hand for calibration: {reason} (a handd without the \
              calibrating request is older than this handctl: update it, or stop it with \
              `handctl stop` before calibrating)"
         )),
-        Err(e) => Err(format!("handd answered {reply:?}: {e}")),
     }
 }
 
@@ -82,20 +66,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn replies_are_read_as_the_daemon_writes_them() {
-        let ok = serde_json::to_string(&Reply::Ok {
+    fn replies_are_read_as_handd_means_them() {
+        let ok = Reply::Ok {
             message: "held".into(),
             status: None,
-        })
-        .expect("json");
-        assert_eq!(parse_reply(&ok), Ok(HoldOutcome::Held("held".into())));
-        let no = serde_json::to_string(&Reply::Refused {
+        };
+        assert_eq!(read_reply(ok), Ok(HoldOutcome::Held("held".into())));
+        let no = Reply::Refused {
             reason: "unknown cmd".into(),
-        })
-        .expect("json");
-        assert!(parse_reply(&no)
-            .expect_err("refused")
-            .contains("unknown cmd"));
+        };
+        assert!(read_reply(no).expect_err("refused").contains("unknown cmd"));
         let mut gone = SocketLink {
             path: "/nonexistent/handd.sock".into(),
         };
