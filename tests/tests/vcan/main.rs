@@ -38,30 +38,24 @@ static CALIBRATION_TRIED: std::sync::atomic::AtomicBool = std::sync::atomic::Ato
 /// The closed loop's handd config and `handctl record` log, for the replay.
 static CLOSED_LOOP: OnceLock<(PathBuf, PathBuf)> = OnceLock::new();
 
-/// The calibration recorded over the bus: scenario, its length (s), the validation split and
-/// the number of trials. The full protocol (3 repetitions, 2 s plateaus, 140 s) is what a
-/// technician records; the quick one (13 trials of 0.5 s, 26 training windows) trains a model
-/// too weak for the closed loop's R² bar (measured 0.71 over vcan).
-const CALIBRATION: (&str, f64, &str, usize) = ("calibration", 140.0, "trial", 39);
-
 /// Where the calibration comes from (environment variables, for the VM's two boots).
 ///
-/// Training is floating-point work that qemu's TCG emulation runs about 50 times slower than
-/// the host (196 s for the default session against 3 s), so `scripts/vm/run` splits the
-/// suite: a first boot records the calibration over vcan into `HANDSTACK_RECORD_ONLY=DIR`
-/// (`DIR/session`) and stops; the host trains it with the same static `handctl`; the second
-/// boot finds the recorded session and the model in `HANDSTACK_CALIBRATION=DIR`
-/// (`DIR/session`, `DIR/model.hsm`) and runs every test on them. Without either variable
-/// (directly on a machine with vcan) the suite records and trains itself.
+/// The calibration is issue 14's workflow over the bus (`calibrate::calibrate_deploy_arm`):
+/// handd without a model, the cued patient, `handctl calibrate --yes` (which records, checks
+/// and trains), `handctl deploy`, `handctl arm`, the closed loop. `scripts/vm/run` runs it in
+/// a first boot with `HANDSTACK_CALIBRATE_INTO=DIR` (the session and the model are copied to
+/// `DIR/session`, `DIR/model.hsm` and exported); the second boot finds them in
+/// `HANDSTACK_CALIBRATION=DIR` and runs every other test on them. Without either variable
+/// (directly on a machine with vcan) the suite calibrates itself once.
 enum CalibrationSource {
-    RecordOnly(PathBuf),
+    CalibrateInto(PathBuf),
     Recorded(PathBuf),
     Here,
 }
 
 fn calibration_source() -> CalibrationSource {
-    if let Some(d) = std::env::var_os("HANDSTACK_RECORD_ONLY") {
-        CalibrationSource::RecordOnly(PathBuf::from(d))
+    if let Some(d) = std::env::var_os("HANDSTACK_CALIBRATE_INTO") {
+        CalibrationSource::CalibrateInto(PathBuf::from(d))
     } else if let Some(d) = std::env::var_os("HANDSTACK_CALIBRATION") {
         CalibrationSource::Recorded(PathBuf::from(d))
     } else {
@@ -69,137 +63,70 @@ fn calibration_source() -> CalibrationSource {
     }
 }
 
-/// The trained model of the calibration (see [`calibration`]).
+/// The model of the calibration (see [`calibration`]).
 fn calibrated_model(env: &VcanEnv) -> &'static Path {
-    calibration(env).expect("a trained model (HANDSTACK_RECORD_ONLY records only)")
+    calibration(env)
 }
 
-/// Calibration over the bus: handsim plays the calibration, `handctl record` records it into a
-/// session, `handctl train` fits ResDD. Done once; later tests reuse the model. Returns the
-/// model, or None when only recording.
-fn calibration(env: &VcanEnv) -> Option<&'static Path> {
-    let record_into = match calibration_source() {
+/// The calibrated model: from the first boot's export, or by running the calibration over the
+/// bus once (later tests reuse it; a failed one fails them at once, not again).
+fn calibration(env: &VcanEnv) -> &'static Path {
+    let into = match calibration_source() {
         CalibrationSource::Recorded(d) => {
             let m = MODEL.get_or_init(|| d.join("model.hsm"));
             for p in [d.join("session").join("session.toml"), m.clone()] {
                 assert!(
                     p.is_file(),
-                    "HANDSTACK_CALIBRATION: {} is missing (scripts/vm/run records the session \
-                     in a first boot and trains it on the host)",
+                    "HANDSTACK_CALIBRATION: {} is missing (scripts/vm/run calibrates in a \
+                     first boot and exports the session and the model)",
                     p.display()
                 );
             }
-            return Some(m);
+            return m;
         }
-        CalibrationSource::RecordOnly(d) => Some(d),
+        CalibrationSource::CalibrateInto(d) => Some(d),
         CalibrationSource::Here => None,
     };
     if let Some(m) = MODEL.get() {
-        return Some(m);
+        return m;
     }
-    // One attempt only: a failed calibration fails every later test at once, not again.
     assert!(
         !CALIBRATION_TRIED.swap(true, std::sync::atomic::Ordering::SeqCst),
-        "the calibration over the bus failed in an earlier test (see a_calibration_...)"
+        "the calibration over the bus failed in an earlier test (see a_calibrate_...)"
     );
-    let dir = match &record_into {
+    let cal = calibrate::calibrate_deploy_arm(env);
+    let model = match into {
         Some(d) => {
-            std::fs::create_dir_all(d).expect("HANDSTACK_RECORD_ONLY directory");
-            d.clone()
+            std::fs::create_dir_all(&d).expect("HANDSTACK_CALIBRATE_INTO directory");
+            copy_dir(&cal.join("session"), &d.join("session"));
+            std::fs::copy(cal.join("model.hsm"), d.join("model.hsm")).expect("copy the model");
+            d.join("model.hsm")
         }
-        None => env.scratch("calibration"),
+        None => cal.join("model.hsm"),
     };
-    let model = {
-        let trials = dir.join("trials.toml");
-        // The trials file first (the in-memory run writes it and stops at once), so the
-        // recorder can check it before the recording starts.
-        let mut t = Proc::spawn(
-            env,
-            "handsim",
-            "handsim-trials",
-            &[
-                "--mem".into(),
-                "--scenario".into(),
-                CALIBRATION.0.into(),
-                "--duration".into(),
-                "0.001".into(),
-                "--trials-out".into(),
-                trials.display().to_string(),
-            ],
-            &dir,
-        );
-        t.wait_success(Duration::from_secs(30));
-        let session = dir.join("session");
-        let mut rec = Proc::spawn(
-            env,
-            "handctl",
-            "record",
-            &[
-                "record".into(),
-                "--iface".into(),
-                env.iface.clone(),
-                "--out".into(),
-                session.display().to_string(),
-                "--duration".into(),
-                format!("{}", CALIBRATION.1 + 1.5),
-                "--trials".into(),
-                trials.display().to_string(),
-            ],
-            &dir,
-        );
-        std::thread::sleep(Duration::from_millis(500));
-        let mut sim = handsim(env, &dir, "handsim", CALIBRATION.0, CALIBRATION.1, &[]);
-        let limit = Duration::from_secs_f64(CALIBRATION.1 + 60.0);
-        sim.wait_success(limit);
-        rec.wait_success(limit);
-        println!("record: {}", rec.output().trim());
-        if record_into.is_some() {
-            return None;
+    MODEL.get_or_init(|| model)
+}
+
+/// Copies the files of directory `from` (one level) into `to`.
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).expect("create the copy's directory");
+    for e in std::fs::read_dir(from).expect("read the session directory") {
+        let e = e.expect("a directory entry");
+        if e.path().is_file() {
+            std::fs::copy(e.path(), to.join(e.file_name())).expect("copy a session file");
         }
-        let model = dir.join("model.hsm");
-        let out = handctl(
-            env,
-            &[
-                "train",
-                &session.display().to_string(),
-                "-o",
-                &model.display().to_string(),
-                "--validation",
-                CALIBRATION.2,
-            ],
-        );
-        println!("train: {}", String::from_utf8_lossy(&out.stdout).trim());
-        model
-    };
-    Some(MODEL.get_or_init(|| model))
+    }
 }
 
 #[test]
-fn a_calibration_recorded_from_the_bus_trains_resdd() {
+fn a_calibrate_deploy_arm_then_the_closed_loop_tracks_a_sine() {
     let env = VcanEnv::get();
     let model = calibration(&env);
-    let session = match (calibration_source(), model) {
-        (CalibrationSource::RecordOnly(d), _) => d.join("session"),
-        (_, Some(m)) => m.parent().expect("dir").join("session"),
-        (_, None) => unreachable!("a model unless recording only"),
-    };
-    let s = decoder::session::Session::open(&session).expect("the recorded session opens");
-    assert_eq!(
-        s.meta.trials.len(),
-        CALIBRATION.3,
-        "trials of {}",
-        CALIBRATION.0
-    );
+    let session = model.parent().expect("dir").join("session");
+    let s = decoder::session::Session::open(&session).expect("the calibrated session opens");
     let report = decoder::session::check_gates(&s, &decoder::session::GateConfig::default())
         .expect("gates run");
     assert!(report.passed(), "quality gates:\n{report}");
-    let Some(model) = model else {
-        println!(
-            "calibration recorded into {}; training is the host's",
-            session.display()
-        );
-        return;
-    };
     let dir = env.scratch("check");
     let cfg = TestConfig::write(&env, &dir, model, 100);
     let out = std::process::Command::new(env.bin("handd"))
@@ -208,7 +135,7 @@ fn a_calibration_recorded_from_the_bus_trains_resdd() {
         .expect("handd runs");
     assert!(
         out.status.success(),
-        "handd --check refused the trained model: {}",
+        "handd --check refused the calibrated model: {}",
         String::from_utf8_lossy(&out.stderr)
     );
 }
