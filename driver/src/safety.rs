@@ -478,6 +478,25 @@ impl<const N: usize> FingerWatch<N> {
 
 #[cfg(test)]
 mod tests {
+    /// hand.dbc's FaultMask comment names every fault at its bit, in handd's order.
+    #[test]
+    fn the_dbc_names_every_fault_bit() {
+        let dbc = include_str!("../../can-dbc/hand.dbc");
+        let line = dbc
+            .lines()
+            .find(|l| l.starts_with("CM_ SG_ 768 FaultMask"))
+            .expect("FaultMask's comment in hand.dbc");
+        for (bit, f) in Fault::ALL.iter().enumerate() {
+            let named = format!("bit {bit} {},", f.name());
+            let last = format!("bit {bit} {};", f.name());
+            assert!(
+                line.contains(&named) || line.contains(&last),
+                "hand.dbc's FaultMask comment does not say {named:?}: {line}"
+            );
+            assert_eq!(f.bit(), 1 << bit);
+        }
+    }
+
     use super::*;
 
     fn running() -> Safety {
