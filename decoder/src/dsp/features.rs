@@ -20,6 +20,37 @@ pub fn window_features(x: &[f64]) -> [f64; FEATURES_PER_CHANNEL] {
     out
 }
 
+/// The features of one multi-channel window stored channel-major (`n_channels` runs of
+/// `window.len() / n_channels` samples each) into `out`, 8 per channel in [`FEATURE_NAMES`]
+/// order: the features-only path, the same per-channel computation as
+/// [`super::Chain::features`] (bit for bit). Allocation-free.
+///
+/// # Panics
+/// If `n_channels` is 0, `window.len()` is not a multiple of it, or `out` is not
+/// `8 * n_channels` long.
+pub fn multichannel_features_into(window: &[f64], n_channels: usize, out: &mut [f64]) {
+    assert!(
+        n_channels > 0 && window.len().is_multiple_of(n_channels),
+        "multichannel_features_into: {} values is not {n_channels} equal channels",
+        window.len()
+    );
+    assert_eq!(
+        out.len(),
+        FEATURES_PER_CHANNEL * n_channels,
+        "multichannel_features_into: output length for {n_channels} channels"
+    );
+    let len = window.len() / n_channels;
+    for (x, o) in window
+        .chunks_exact(len.max(1))
+        .zip(out.chunks_exact_mut(FEATURES_PER_CHANNEL))
+    {
+        features_into(x, o);
+    }
+    if len == 0 {
+        out.fill(0.0);
+    }
+}
+
 /// Lanes of partial sums: two independent accumulators break the add latency chain and let
 /// the compiler vectorise; the order of additions is fixed, so results are deterministic.
 const LANES: usize = 2;
