@@ -265,6 +265,8 @@ fn features_only_path_matches_libemg_definitions() {
             }
         }
     }
-    eprintln!("features-only path vs LibEMG definitions on {n} windows: worst rel. error {worst:e}");
+    eprintln!(
+        "features-only path vs LibEMG definitions on {n} windows: worst rel. error {worst:e}"
+    );
     let _ = std::fs::remove_dir_all(&out);
 }

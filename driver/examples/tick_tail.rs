@@ -62,10 +62,15 @@ fn traffic() -> Vec<Vec<(u64, CanFrame)>> {
         .ramp_to(Intent::all(-1.0), 10_000_000)
         .rest(4_000_000);
     let mut frames = Vec::new();
-    run_on_mem_bus(WorldConfig::default(), PatientMode::Script(s), SPAN_US, |t, f| {
-        frames.push((t, *f));
-        Ok::<_, ()>(())
-    })
+    run_on_mem_bus(
+        WorldConfig::default(),
+        PatientMode::Script(s),
+        SPAN_US,
+        |t, f| {
+            frames.push((t, *f));
+            Ok::<_, ()>(())
+        },
+    )
     .expect("world")
     .expect("recording");
     let mut ticks = vec![Vec::new(); (SPAN_US / TICK_US) as usize];
