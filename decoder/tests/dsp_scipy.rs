@@ -8,7 +8,9 @@
 mod dsp_common;
 
 use decoder::dsp::npy::read_npy;
-use decoder::dsp::{batch_features, batch_filtered, ChainConfig, FeatureSignal, Sos};
+use decoder::dsp::{
+    batch_features, batch_filtered, multichannel_features_into, ChainConfig, FeatureSignal, Sos,
+};
 use dsp_common::{data_path, rel_err, run_reference, temp_dir};
 use serde_json::Value;
 use std::path::Path;
@@ -214,6 +216,57 @@ fn chain_matches_scipy_and_numpy_on_real_recordings() {
     eprintln!(
         "dsp vs scipy/numpy on {} recordings: worst filtered rel. error {worst_filter:e}, worst feature rel. error {worst_feature:e}",
         recordings.len()
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// The features-only path against LibEMG's definitions (issue 15), reproduced in numpy by
+/// `decoder/ref/libemg_features.py` (LibEMG itself only in `scripts/bench`): RMS, MAV, VAR,
+/// IAV (our INT), WL and DASDV over 200-sample windows of the real 3DC recording, centred and
+/// rectified. LibEMG's VAR is `np.var` (divides by N), ours divides by N - 1: compared as
+/// `ours * (N - 1) / N`.
+#[test]
+fn features_only_path_matches_libemg_definitions() {
+    let out = temp_dir("dsp-libemg");
+    let data_dir = data_path("3dc-armband-p4");
+    run_reference(
+        "libemg_features.py",
+        &[
+            "reference",
+            out.to_str().expect("utf-8 temp path"),
+            data_dir.to_str().expect("utf-8 data path"),
+        ],
+    );
+    let (wshape, windows) = load(&out, "windows.npy");
+    let (fshape, theirs) = load(&out, "libemg_features.npy");
+    let [n, ch, len] = wshape[..] else {
+        panic!("windows.npy shape {wshape:?}")
+    };
+    assert_eq!(fshape, vec![n, 6, ch], "libemg_features.npy shape");
+    assert!(n >= 40 && ch == 10 && len == 200, "windows {wshape:?}");
+    let nf = len as f64;
+    // LibEMG feature k is our feature OURS[k] times SCALE[k].
+    const OURS: [usize; 6] = [0, 1, 2, 4, 5, 6];
+    let scale = [1.0, 1.0, (nf - 1.0) / nf, 1.0, 1.0, 1.0];
+    let mut feats = vec![0.0; 8 * ch];
+    let mut worst = 0.0f64;
+    for (i, w) in windows.chunks_exact(ch * len).enumerate() {
+        multichannel_features_into(w, ch, &mut feats);
+        for (k, (&o, s)) in OURS.iter().zip(scale).enumerate() {
+            for c in 0..ch {
+                let want = theirs[(i * 6 + k) * ch + c];
+                let got = feats[c * 8 + o] * s;
+                let e = (got - want).abs() / want.abs().max(f64::MIN_POSITIVE);
+                worst = worst.max(e);
+                assert!(
+                    e <= TOL,
+                    "window {i} channel {c} feature {k}: ours {got} LibEMG-numpy {want} (rel. {e:e})"
+                );
+            }
+        }
+    }
+    eprintln!(
+        "features-only path vs LibEMG definitions on {n} windows: worst rel. error {worst:e}"
     );
     let _ = std::fs::remove_dir_all(&out);
 }

@@ -20,12 +20,43 @@ pub fn window_features(x: &[f64]) -> [f64; FEATURES_PER_CHANNEL] {
     out
 }
 
-/// Lanes of partial sums: two independent accumulators break the add latency chain and let
+/// The features of one multi-channel window stored channel-major (`n_channels` runs of
+/// `window.len() / n_channels` samples each) into `out`, 8 per channel in [`FEATURE_NAMES`]
+/// order: the features-only path, the same per-channel computation as
+/// [`super::Chain::features`] (bit for bit). Allocation-free.
+///
+/// # Panics
+/// If `n_channels` is 0, `window.len()` is not a multiple of it, or `out` is not
+/// `8 * n_channels` long.
+pub fn multichannel_features_into(window: &[f64], n_channels: usize, out: &mut [f64]) {
+    assert!(
+        n_channels > 0 && window.len().is_multiple_of(n_channels),
+        "multichannel_features_into: {} values is not {n_channels} equal channels",
+        window.len()
+    );
+    assert_eq!(
+        out.len(),
+        FEATURES_PER_CHANNEL * n_channels,
+        "multichannel_features_into: output length for {n_channels} channels"
+    );
+    let len = window.len() / n_channels;
+    for (x, o) in window
+        .chunks_exact(len.max(1))
+        .zip(out.chunks_exact_mut(FEATURES_PER_CHANNEL))
+    {
+        features_into(x, o);
+    }
+    if len == 0 {
+        out.fill(0.0);
+    }
+}
+
+/// Lanes of partial sums: four independent accumulators break the add latency chain and let
 /// the compiler vectorise; the order of additions is fixed, so results are deterministic.
-const LANES: usize = 2;
+const LANES: usize = 4;
 
 fn lane_sum(acc: [f64; LANES]) -> f64 {
-    acc[0] + acc[1]
+    (acc[0] + acc[2]) + (acc[1] + acc[3])
 }
 
 /// Sums over one window: enough to get its 8 features.
@@ -43,46 +74,23 @@ struct Stats {
 
 impl Stats {
     /// Statistics of the window `x` (at least 2 samples). Allocation-free.
+    ///
+    /// Three short passes (sums of x; of the differences; of squared deviations from the
+    /// mean), each a plain loop over fixed-size chunks that the compiler vectorises; the
+    /// window is in L1, so the extra passes cost less than one tangled loop.
     fn of(x: &[f64]) -> Stats {
         let n = x.len();
         debug_assert!(n > 1);
-        // One pass over the pairs (x[i], x[i+1]), i < n - 1: the sums of x[i] and of the
-        // differences together; x[n-1] is added at the end.
-        let (mut sum, mut sum_abs, mut sum_sq) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
-        let (mut wl, mut d_sq) = ([0.0; LANES], [0.0; LANES]);
-        let (prev, next) = (&x[..n - 1], &x[1..]);
-        let pc = prev.chunks_exact(LANES);
-        let nc = next.chunks_exact(LANES);
-        let (prest, nrest) = (pc.remainder(), nc.remainder());
-        for (p, q) in pc.zip(nc) {
-            for l in 0..LANES {
-                let v = p[l];
-                sum[l] += v;
-                sum_abs[l] += v.abs();
-                sum_sq[l] += v * v;
-                let d = q[l] - v;
-                wl[l] += d.abs();
-                d_sq[l] += d * d;
-            }
-        }
-        for (l, (&v, &q)) in prest.iter().zip(nrest).enumerate() {
-            sum[l] += v;
-            sum_abs[l] += v.abs();
-            sum_sq[l] += v * v;
-            let d = q - v;
-            wl[l] += d.abs();
-            d_sq[l] += d * d;
-        }
-        let last = x[n - 1];
+        let (sum, sum_abs, sum_sq) = sums(x);
+        let (wl, d_sq) = difference_sums(x);
         let nf = n as f64;
-        let mean = (lane_sum(sum) + last) / nf;
         Stats {
             n: nf,
-            sum_abs: lane_sum(sum_abs) + last.abs(),
-            sum_sq: lane_sum(sum_sq) + last * last,
-            wl: lane_sum(wl),
-            d_sq: lane_sum(d_sq),
-            m2: squared_deviations(x, mean),
+            sum_abs,
+            sum_sq,
+            wl,
+            d_sq,
+            m2: squared_deviations(x, sum / nf),
         }
     }
 
@@ -101,12 +109,51 @@ impl Stats {
     }
 }
 
+/// Sums of `x[i]`, `|x[i]|` and `x[i]^2`.
+fn sums(x: &[f64]) -> (f64, f64, f64) {
+    let (mut sum, mut sum_abs, mut sum_sq) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
+    let (chunks, rest) = x.as_chunks::<LANES>();
+    for c in chunks {
+        for l in 0..LANES {
+            sum[l] += c[l];
+            sum_abs[l] += c[l].abs();
+            sum_sq[l] += c[l] * c[l];
+        }
+    }
+    for (l, &v) in rest.iter().enumerate() {
+        sum[l] += v;
+        sum_abs[l] += v.abs();
+        sum_sq[l] += v * v;
+    }
+    (lane_sum(sum), lane_sum(sum_abs), lane_sum(sum_sq))
+}
+
+/// Sums of `|x[i+1] - x[i]|` and `(x[i+1] - x[i])^2`, `i < n - 1`.
+fn difference_sums(x: &[f64]) -> (f64, f64) {
+    let (mut wl, mut d_sq) = ([0.0; LANES], [0.0; LANES]);
+    let n = x.len();
+    let (pc, prest) = x[..n - 1].as_chunks::<LANES>();
+    let (nc, nrest) = x[1..].as_chunks::<LANES>();
+    for (p, q) in pc.iter().zip(nc) {
+        for l in 0..LANES {
+            let d = q[l] - p[l];
+            wl[l] += d.abs();
+            d_sq[l] += d * d;
+        }
+    }
+    for (l, (&p, &q)) in prest.iter().zip(nrest).enumerate() {
+        let d = q - p;
+        wl[l] += d.abs();
+        d_sq[l] += d * d;
+    }
+    (lane_sum(wl), lane_sum(d_sq))
+}
+
 /// Sum of `(x[i] - mean)^2`, the second pass: the rectified signal has a large mean next to
 /// its spread, and the one-pass form would cancel catastrophically.
 fn squared_deviations(x: &[f64], mean: f64) -> f64 {
     let mut ss = [0.0; LANES];
-    let chunks = x.chunks_exact(LANES);
-    let rest = chunks.remainder();
+    let (chunks, rest) = x.as_chunks::<LANES>();
     for c in chunks {
         for l in 0..LANES {
             let d = c[l] - mean;

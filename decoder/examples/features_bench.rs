@@ -1,0 +1,67 @@
+//! The features-only path against LibEMG (issue 15): the per-window CPU time of
+//! [`decoder::dsp::multichannel_features_into`] over the windows that
+//! `decoder/ref/features_libemg_bench.py` times LibEMG's FeatureExtractor on.
+//!
+//! `cargo run --release -p decoder --example features_bench -- WINDOWS.npy [--json]`
+//!
+//! WINDOWS.npy is float64 `(n_windows, channels, samples)` (LibEMG's layout, channel-major per
+//! window, as ours). Prints the median over rounds of the thread's CPU time per window, one
+//! window per call as online; with `--json` one line
+//! `{"what":"features_window","impl":"handstack","us_cpu_per_window":X,...}`.
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use cpu_time::ThreadTime;
+use decoder::dsp::multichannel_features_into;
+use decoder::dsp::npy::read_npy;
+
+/// Rounds timed; the median is reported.
+const ROUNDS: usize = 15;
+/// Passes over all windows per round.
+const PASSES: usize = 20;
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let json = args.iter().any(|a| a == "--json");
+    let Some(path) = args.iter().find(|a| !a.starts_with("--")) else {
+        eprintln!("usage: features_bench WINDOWS.npy [--json]");
+        std::process::exit(2);
+    };
+    let a = read_npy(path).unwrap_or_else(|e| {
+        eprintln!("features_bench: {path}: {e}");
+        std::process::exit(1);
+    });
+    let [n_windows, channels, samples] = a.shape[..] else {
+        eprintln!("features_bench: {path}: shape {:?}, want 3 axes", a.shape);
+        std::process::exit(1);
+    };
+    let per_window = channels * samples;
+    let mut out = vec![0.0; 8 * channels];
+    let mut rounds: Vec<Duration> = (0..ROUNDS)
+        .map(|_| {
+            let start = ThreadTime::now();
+            for _ in 0..PASSES {
+                for w in a.data.chunks_exact(per_window) {
+                    multichannel_features_into(black_box(w), channels, &mut out);
+                    black_box(&out);
+                }
+            }
+            start.elapsed()
+        })
+        .collect();
+    rounds.sort();
+    let calls = (PASSES * n_windows) as f64;
+    let us = |d: Duration| d.as_secs_f64() * 1e6 / calls;
+    let (median, best) = (us(rounds[ROUNDS / 2]), us(rounds[0]));
+    if json {
+        println!(
+            "{{\"what\":\"features_window\",\"impl\":\"handstack\",\"us_cpu_per_window\":{median:.4},\"us_cpu_best\":{best:.4},\"windows\":{n_windows},\"channels\":{channels},\"samples\":{samples}}}"
+        );
+    } else {
+        println!(
+            "handstack features of one {channels} x {samples} window: median {median:.3} us CPU (best {best:.3}) over {ROUNDS} rounds of {} calls",
+            PASSES * n_windows
+        );
+    }
+}
