@@ -287,7 +287,7 @@ fn the_polynomials_are_the_model() {
         let mut v = RayVerifier::exact(&model).unwrap();
         for _ in 0..20 {
             let f = random_features(&mut rng, n_in, false);
-            let RayCurves::Polynomials(p) = v.curves(&f) else {
+            let RayCurves::Polynomials(p, None) = v.curves(&f) else {
                 panic!("a {kind} model verifies exactly");
             };
             for _ in 0..10 {
