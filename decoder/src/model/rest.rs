@@ -216,3 +216,82 @@ pub(crate) fn with_fitted_rest(
     let stage = RestStage::fit(&outputs, &fit)?;
     Ok(raw.with_rest_stage(Some(stage)))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn width() -> impl Strategy<Value = f64> {
+        prop_oneof![Just(0.0), 0.0..=MAX_REST_WIDTH]
+    }
+
+    proptest! {
+        /// For any widths and sharpness: ±1 maps to ±1 exactly, 0 to 0, the map is
+        /// non-decreasing, keeps every sign, and its slope stays within `max_slope`.
+        #[test]
+        fn the_stage_is_monotonic_keeps_signs_and_maps_unit_to_unit(
+            up in proptest::array::uniform5(width()),
+            down in proptest::array::uniform5(width()),
+            n in 1.0f64..=16.0,
+            a in -3.0f64..3.0,
+            b in -3.0f64..3.0,
+        ) {
+            let s = RestStage::try_new(up, down, n).unwrap();
+            let (lo, hi) = if a <= b { (a, b) } else { (b, a) };
+            for f in 0..N_FINGERS {
+                prop_assert_eq!(s.map(f, 1.0), 1.0);
+                prop_assert_eq!(s.map(f, -1.0), -1.0);
+                prop_assert_eq!(s.map(f, 0.0), 0.0);
+                let (gl, gh) = (s.map(f, lo), s.map(f, hi));
+                prop_assert!(gl <= gh, "finger {f}: g({lo}) = {gl} > g({hi}) = {gh}");
+                prop_assert!(gh - gl <= s.max_slope(f) * (hi - lo) * (1.0 + 1e-12) + 1e-15);
+                for v in [lo, hi] {
+                    let g = s.map(f, v);
+                    prop_assert!(g == 0.0 || g.signum() == v.signum(), "g({v}) = {g}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_wide_stage_pulls_rest_toward_zero_and_leaves_full_effort_alone() {
+        let s = RestStage::try_new([0.2; N_FINGERS], [0.1; N_FINGERS], REST_SHARPNESS).unwrap();
+        assert!(s.map(0, 0.1).abs() < 0.02, "{}", s.map(0, 0.1));
+        assert!(s.map(0, -0.05).abs() < 0.01, "{}", s.map(0, -0.05));
+        // Well above the width, the output is the shifted input, rescaled.
+        let above = s.map(0, 0.8);
+        assert!((above - (0.8 - 0.2) / (1.0 - 0.2)).abs() < 0.01, "{above}");
+    }
+
+    #[test]
+    fn fit_reads_the_quantile_of_each_side_and_bad_input_is_refused() {
+        let outputs: Vec<[f64; N_FINGERS]> = (0..=100)
+            .map(|i| {
+                let v = i as f64 / 100.0; // 0.00 ..= 1.00
+                [0.3 * v, -0.2 * v, 0.1 * v - 0.05, 0.0, 0.9 * v]
+            })
+            .collect();
+        let fit = RestFit {
+            quantile: 0.9,
+            max_width: 0.5,
+        };
+        let s = RestStage::fit(&outputs, &fit).unwrap();
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
+        assert!(close(s.up()[0], 0.27) && close(s.down()[0], 0.0), "{s:?}");
+        assert!(close(s.up()[1], 0.0) && close(s.down()[1], 0.2 * 0.9), "{s:?}");
+        assert!(close(s.up()[2], 0.04) && close(s.down()[2], 0.04), "{s:?}");
+        assert!(close(s.up()[3], 0.0) && close(s.down()[3], 0.0), "{s:?}");
+        assert!(close(s.up()[4], 0.5), "capped at max_width: {s:?}");
+        assert!(RestStage::fit(&[], &fit).is_err());
+        let e = RestStage::fit(&[[0.0, f64::NAN, 0.0, 0.0, 0.0]], &fit).unwrap_err();
+        assert!(e.to_string().contains("rest window 0"), "{e}");
+        let e = RestStage::try_new([0.0, 0.0, -0.1, 0.0, 0.0], [0.0; N_FINGERS], 4.0);
+        assert!(e.unwrap_err().to_string().contains("up of finger 2"));
+        let bad = RestFit {
+            quantile: 0.2,
+            ..RestFit::default()
+        };
+        assert!(bad.validate().unwrap_err().to_string().contains("quantile"));
+    }
+}
