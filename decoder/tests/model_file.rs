@@ -293,7 +293,9 @@ fn verification_and_rest_level_round_trip_and_old_files_load() {
     let meta = split(&old).meta;
     assert!(meta.get("verification").is_none() && meta.get("rest_rms_uv").is_none());
     // The calibration has rest windows, so training fitted a rest stage and the file keeps it.
-    let stage = *plain.rest_stage().expect("a rest stage from the rest windows");
+    let stage = *plain
+        .rest_stage()
+        .expect("a rest stage from the rest windows");
     assert!(meta.get("rest_stage").is_some());
     let back = TrainedModel::from_bytes(&old, Some(&chain(2))).unwrap();
     assert_eq!((back.verification(), back.rest_rms_uv()), (None, None));

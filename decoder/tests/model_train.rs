@@ -3,8 +3,8 @@
 mod model_support;
 
 use decoder::model::{
-    train, CnnSpec, RestFit, Dataset, EffortPenalty, EpochReport, LnSpec, MlpSpec, Model, ModelKind,
-    ModelSpec, Optimizer, ResDdSpec, TrainConfig, TrainError, Trainable, ValidationSplit,
+    train, CnnSpec, Dataset, EffortPenalty, EpochReport, LnSpec, MlpSpec, Model, ModelKind,
+    ModelSpec, Optimizer, ResDdSpec, RestFit, TrainConfig, TrainError, Trainable, ValidationSplit,
 };
 use model_support::{calibration, chain};
 
@@ -399,7 +399,14 @@ fn the_rest_stage_lowers_the_rest_level_and_keeps_every_sign() {
     let data = calibration(2, 2, 12, 3);
     let fresh = calibration(2, 3, 12, 3);
     let first_new_trial = data.trial_ids().len();
-    let m = train(ModelKind::ResDd, &small_spec(), &data, &quick(30), &mut |_| {}).unwrap();
+    let m = train(
+        ModelKind::ResDd,
+        &small_spec(),
+        &data,
+        &quick(30),
+        &mut |_| {},
+    )
+    .unwrap();
     let stage = *m.rest_stage().expect("rest windows give a rest stage");
     let raw = m.clone().with_rest_stage(None);
     for (what, from) in [("calibration", 0), ("fresh windows", first_new_trial)] {
@@ -424,7 +431,14 @@ fn the_rest_stage_lowers_the_rest_level_and_keeps_every_sign() {
         }
         d
     };
-    let m2 = train(ModelKind::Ln, &small_spec(), &two_point, &quick(2), &mut |_| {}).unwrap();
+    let m2 = train(
+        ModelKind::Ln,
+        &small_spec(),
+        &two_point,
+        &quick(2),
+        &mut |_| {},
+    )
+    .unwrap();
     assert_eq!(m2.rest_stage(), None);
     let off = TrainConfig {
         rest: None,

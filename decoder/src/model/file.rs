@@ -405,7 +405,12 @@ impl TrainedModel {
         let model = AnyModel::from_params(meta.kind, &meta.spec, n_in, N_FINGERS, params.to_vec())?;
         let normalizer = Normalizer::from_scales(scales.to_vec())?;
         let trained = TrainedModel::new(model, meta.spec, normalizer, chain, meta.summary)?;
-        with_records(trained, meta.verification, meta.rest_rms_uv, meta.rest_stage)
+        with_records(
+            trained,
+            meta.verification,
+            meta.rest_rms_uv,
+            meta.rest_stage,
+        )
     }
 
     /// Writes the model atomically ([`crate::fsio::write_atomic`]: a temporary file in the same

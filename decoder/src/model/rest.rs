@@ -279,7 +279,10 @@ mod tests {
         let s = RestStage::fit(&outputs, &fit).unwrap();
         let close = |a: f64, b: f64| (a - b).abs() < 1e-12;
         assert!(close(s.up()[0], 0.27) && close(s.down()[0], 0.0), "{s:?}");
-        assert!(close(s.up()[1], 0.0) && close(s.down()[1], 0.2 * 0.9), "{s:?}");
+        assert!(
+            close(s.up()[1], 0.0) && close(s.down()[1], 0.2 * 0.9),
+            "{s:?}"
+        );
         assert!(close(s.up()[2], 0.04) && close(s.down()[2], 0.04), "{s:?}");
         assert!(close(s.up()[3], 0.0) && close(s.down()[3], 0.0), "{s:?}");
         assert!(close(s.up()[4], 0.5), "capped at max_width: {s:?}");

@@ -74,12 +74,7 @@ pub fn exact_reversal(y: &[f64], dir: f64) -> Reversal {
 /// [`exact_reversal`] of `g(y(k))` for a non-decreasing `g` whose slope is at most `slope`
 /// (the rest stage): `g` keeps the order of values, so the extremes of `g∘y` are still among
 /// the critical points of `y`, and the bound grows by `slope`.
-pub fn exact_reversal_through(
-    y: &[f64],
-    dir: f64,
-    g: &dyn Fn(f64) -> f64,
-    slope: f64,
-) -> Reversal {
+pub fn exact_reversal_through(y: &[f64], dir: f64, g: &dyn Fn(f64) -> f64, slope: f64) -> Reversal {
     let roots = roots_in_unit(&derivative(y));
     let mut ks = roots.points;
     ks.extend([0.0, 1.0]);
