@@ -292,6 +292,11 @@ fn verification_and_rest_level_round_trip_and_old_files_load() {
     let old = plain.to_bytes().unwrap();
     let meta = split(&old).meta;
     assert!(meta.get("verification").is_none() && meta.get("rest_rms_uv").is_none());
+    // The calibration has rest windows, so training fitted a rest stage and the file keeps it.
+    let stage = *plain
+        .rest_stage()
+        .expect("a rest stage from the rest windows");
+    assert!(meta.get("rest_stage").is_some());
     let back = TrainedModel::from_bytes(&old, Some(&chain(2))).unwrap();
     assert_eq!((back.verification(), back.rest_rms_uv()), (None, None));
     assert!(
@@ -325,6 +330,16 @@ fn verification_and_rest_level_round_trip_and_old_files_load() {
         TrainedModel::from_bytes(&join(&p), Some(&chain(2))).unwrap(),
         plain
     );
+    // A file from before the rest stage (no `rest_stage` key) loads, with raw outputs.
+    p.meta.as_object_mut().unwrap().remove("rest_stage");
+    let raw = TrainedModel::from_bytes(&join(&p), Some(&chain(2))).unwrap();
+    assert_eq!(raw.rest_stage(), None);
+    assert_eq!(raw, plain.clone().with_rest_stage(None));
+    let x = vec![20.0; 16];
+    let (staged, unstaged) = (plain.predict(&x), raw.predict(&x));
+    for f in 0..5 {
+        assert_eq!(staged[f], stage.map(f, unstaged[f]), "finger {f}");
+    }
 }
 
 #[test]
@@ -363,6 +378,11 @@ fn the_checksum_covers_the_new_sections_and_bad_ones_are_refused() {
         ("verification", serde_json::json!({"tolerance": -1.0})),
         ("rest_rms_uv", serde_json::json!([1.0])),
         ("rest_rms_uv", serde_json::json!([1.0, -2.0])),
+        (
+            "rest_stage",
+            serde_json::json!({"up": [0.1, 0.1, -0.3, 0.1, 0.1]}),
+        ),
+        ("rest_stage", serde_json::json!({"sharpness": 0.0})),
     ];
     for (key, patch) in bad {
         let mut p = split(&good);

@@ -4,7 +4,7 @@ mod model_support;
 
 use decoder::model::{
     train, CnnSpec, Dataset, EffortPenalty, EpochReport, LnSpec, MlpSpec, Model, ModelKind,
-    ModelSpec, Optimizer, ResDdSpec, TrainConfig, TrainError, Trainable, ValidationSplit,
+    ModelSpec, Optimizer, ResDdSpec, RestFit, TrainConfig, TrainError, Trainable, ValidationSplit,
 };
 use model_support::{calibration, chain};
 
@@ -378,4 +378,81 @@ fn names_parse() {
         "by-magic".parse::<ValidationSplit>().unwrap_err(),
         TrainError::Config(ref m) if m.contains("trial-tail")
     ));
+}
+
+/// Mean |output| over the rest windows (every target 0) of `d` whose trial is at least
+/// `from_trial`.
+fn rest_level(m: &decoder::model::TrainedModel, d: &Dataset, from_trial: usize) -> f64 {
+    let rows: Vec<usize> = (0..d.len())
+        .filter(|&i| d.trial(i) >= from_trial && d.target(i).iter().all(|&t| t == 0.0))
+        .collect();
+    let sum: f64 = rows
+        .iter()
+        .map(|&i| m.predict(d.row(i)).iter().map(|v| v.abs()).sum::<f64>())
+        .sum();
+    sum / (5 * rows.len()) as f64
+}
+
+#[test]
+fn the_rest_stage_lowers_the_rest_level_and_keeps_every_sign() {
+    // Two repetitions to train on; the third (same mixing, fresh noise) is new data.
+    let data = calibration(2, 2, 12, 3);
+    let fresh = calibration(2, 3, 12, 3);
+    let first_new_trial = data.trial_ids().len();
+    let m = train(
+        ModelKind::ResDd,
+        &small_spec(),
+        &data,
+        &quick(30),
+        &mut |_| {},
+    )
+    .unwrap();
+    let stage = *m.rest_stage().expect("rest windows give a rest stage");
+    let raw = m.clone().with_rest_stage(None);
+    for (what, from) in [("calibration", 0), ("fresh windows", first_new_trial)] {
+        let (before, after) = (rest_level(&raw, &fresh, from), rest_level(&m, &fresh, from));
+        assert!(
+            after < 0.7 * before,
+            "{what}: rest level {before} -> {after} with {stage:?}"
+        );
+    }
+    for i in 0..fresh.len() {
+        let (y, r) = (m.predict(fresh.row(i)), raw.predict(fresh.row(i)));
+        for f in 0..5 {
+            assert!(y[f] == 0.0 || y[f].signum() == r[f].signum(), "window {i}");
+        }
+    }
+    // Without rest windows (a two-point calibration) or with the stage off: raw outputs.
+    let two_point = {
+        let mut d = Dataset::new(chain(2)).unwrap();
+        for i in (0..data.len()).filter(|&i| data.target(i).iter().any(|&t| t != 0.0)) {
+            d.push(data.row(i), *data.target(i), *data.mask(i), data.trial(i))
+                .unwrap();
+        }
+        d
+    };
+    let m2 = train(
+        ModelKind::Ln,
+        &small_spec(),
+        &two_point,
+        &quick(2),
+        &mut |_| {},
+    )
+    .unwrap();
+    assert_eq!(m2.rest_stage(), None);
+    let off = TrainConfig {
+        rest: None,
+        ..quick(2)
+    };
+    let m3 = train(ModelKind::Ln, &small_spec(), &data, &off, &mut |_| {}).unwrap();
+    assert_eq!(m3.rest_stage(), None);
+    let bad = TrainConfig {
+        rest: Some(RestFit {
+            max_width: 2.0,
+            ..RestFit::default()
+        }),
+        ..quick(2)
+    };
+    let e = train(ModelKind::Ln, &small_spec(), &data, &bad, &mut |_| {}).unwrap_err();
+    assert!(e.to_string().contains("max_width"), "{e}");
 }

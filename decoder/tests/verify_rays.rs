@@ -9,8 +9,8 @@ use decoder::model::verify::{
     DEFAULT_TOLERANCE, SAMPLED_POINTS,
 };
 use decoder::model::{
-    AnyModel, LnSpec, Model, ModelKind, ModelSpec, Normalizer, ResDdSpec, ResDdVariant, Trainable,
-    TrainedModel, TrainingSummary, N_FINGERS,
+    AnyModel, LnSpec, Model, ModelKind, ModelSpec, Normalizer, ResDdSpec, ResDdVariant, RestStage,
+    Trainable, TrainedModel, TrainingSummary, N_FINGERS,
 };
 use decoder::session::{LabelledWindows, Trial, TrialKind, WindowLabel};
 use proptest::prelude::*;
@@ -287,7 +287,7 @@ fn the_polynomials_are_the_model() {
         let mut v = RayVerifier::exact(&model).unwrap();
         for _ in 0..20 {
             let f = random_features(&mut rng, n_in, false);
-            let RayCurves::Polynomials(p) = v.curves(&f) else {
+            let RayCurves::Polynomials(p, None) = v.curves(&f) else {
                 panic!("a {kind} model verifies exactly");
             };
             for _ in 0..10 {
@@ -320,11 +320,16 @@ proptest! {
         features in proptest::collection::vec(0.0f64..3.0, 8),
         dir in prop_oneof![Just(1.0f64), Just(-1.0f64)],
         finger in 0..N_FINGERS,
+        width in prop_oneof![Just(0.0f64), 0.0f64..0.5],
     ) {
         let variant = if chained { ResDdVariant::Chained } else { ResDdVariant::InputGated };
         let spec = resdd_spec(4, 2, variant);
         let model = AnyModel::random(ModelKind::ResDd, &spec, 8, N_FINGERS, seed).unwrap();
-        let model = bundle(model, spec, Normalizer::identity(8));
+        // With a rest stage (width > 0) the exact reading goes through it, like the forward pass.
+        let stage = (width > 0.0).then(|| {
+            RestStage::try_new([width; N_FINGERS], [0.5 * width; N_FINGERS], 4.0).unwrap()
+        });
+        let model = bundle(model, spec, Normalizer::identity(8)).with_rest_stage(stage);
         let mut v = RayVerifier::exact(&model).unwrap();
         let exact = v.curves(&features).reversal(finger, dir);
         let n = 2001;

@@ -224,9 +224,13 @@ pub struct TrainingOpts {
     #[arg(long)]
     pub two_point: bool,
     /// The paper's plain training: masked MSE alone, without the effort-ray penalty that keeps
-    /// the decoder monotonic in effort.
+    /// the decoder monotonic in effort, and raw outputs (no rest stage).
     #[arg(long)]
     pub plain: bool,
+    /// Raw outputs: no rest stage (the soft dead zone per finger fitted from the rest windows
+    /// that keeps a relaxed hand still).
+    #[arg(long)]
+    pub no_rest_stage: bool,
     /// The paper's labels: during a single-finger trial the other fingers are left out of the
     /// loss instead of being trained toward 0.
     #[arg(long)]

@@ -49,6 +49,7 @@ pub(super) fn fit(
         max_epochs: opts.epochs,
         seed: opts.seed,
         split: opts.validation,
+        rest: if opts.no_rest_stage { None } else { base.rest },
         ..base
     };
     let mut progress = Progress::new(kind.name());

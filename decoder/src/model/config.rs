@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 use super::effort::EffortPenalty;
 use super::error::TrainError;
+use super::rest::RestFit;
 
 /// Gradient step rule.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -185,6 +186,10 @@ pub struct TrainConfig {
     /// with).
     #[serde(default)]
     pub effort: Option<EffortPenalty>,
+    /// The rest stage fitted after training from the rest windows (default on; `None` is the
+    /// paper's raw output, and what a model file without the field was trained with).
+    #[serde(default)]
+    pub rest: Option<RestFit>,
 }
 
 impl Default for TrainConfig {
@@ -198,15 +203,18 @@ impl Default for TrainConfig {
             split: ValidationSplit::default(),
             seed: 0,
             effort: Some(EffortPenalty::default()),
+            rest: Some(RestFit::default()),
         }
     }
 }
 
 impl TrainConfig {
-    /// The paper's plain training: the defaults without the effort-ray penalty.
+    /// The paper's plain training: the defaults without the effort-ray penalty and without the
+    /// rest stage.
     pub fn plain() -> Self {
         TrainConfig {
             effort: None,
+            rest: None,
             ..TrainConfig::default()
         }
     }
@@ -216,6 +224,9 @@ impl TrainConfig {
         self.optimizer.validate()?;
         if let Some(effort) = &self.effort {
             effort.validate()?;
+        }
+        if let Some(rest) = &self.rest {
+            rest.validate()?;
         }
         let bad = |m: String| Err(TrainError::Config(m));
         if self.batch_size == 0 || self.batch_size > 1 << 20 {
@@ -259,10 +270,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_config_without_the_effort_field_is_the_plain_training() {
+    fn a_config_without_the_effort_and_rest_fields_is_the_plain_training() {
         let mut json = serde_json::to_value(TrainConfig::default()).expect("serialise");
         assert!(json["effort"].is_object(), "{json}");
+        assert!(json["rest"].is_object(), "{json}");
         json.as_object_mut().expect("object").remove("effort");
+        json.as_object_mut().expect("object").remove("rest");
         let old: TrainConfig = serde_json::from_value(json).expect("old files still load");
         assert_eq!(old, TrainConfig::plain());
         assert_ne!(old, TrainConfig::default());

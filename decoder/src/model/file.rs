@@ -36,6 +36,7 @@ use super::dataset::N_FINGERS;
 use super::error::FileError;
 use super::kind::ModelKind;
 use super::normalizer::Normalizer;
+use super::rest::RestStage;
 use super::spec::ModelSpec;
 use super::summary::TrainingSummary;
 use super::trained::TrainedModel;
@@ -78,6 +79,9 @@ struct Meta {
     /// Absent in older files, and when the calibration had no rest trials.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     rest_rms_uv: Option<Vec<f64>>,
+    /// Absent in older files, and for a model without a rest stage (raw outputs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    rest_stage: Option<RestStage>,
 }
 
 const FORMAT_NAME: &str = "handstack-model";
@@ -301,6 +305,7 @@ fn with_records(
     mut model: TrainedModel,
     verification: Option<VerificationRecord>,
     rest: Option<Vec<f64>>,
+    stage: Option<RestStage>,
 ) -> Result<TrainedModel, FileError> {
     let malformed =
         |what: &str, e: super::error::ModelError| FileError::Malformed(format!("{what}: {e}"));
@@ -313,6 +318,11 @@ fn with_records(
         model = model
             .with_rest_rms_uv(r)
             .map_err(|e| malformed("rest_rms_uv", e))?;
+    }
+    if let Some(st) = stage {
+        let checked = RestStage::try_new(*st.up(), *st.down(), st.sharpness())
+            .map_err(|e| malformed("rest_stage", e))?;
+        model = model.with_rest_stage(Some(checked));
     }
     Ok(model)
 }
@@ -352,6 +362,7 @@ impl TrainedModel {
             summary: self.summary.clone(),
             verification: self.verification.clone(),
             rest_rms_uv: self.rest_rms_uv.clone(),
+            rest_stage: self.rest_stage,
         };
         let meta_json =
             serde_json::to_vec_pretty(&meta).map_err(|e| FileError::Malformed(e.to_string()))?;
@@ -394,7 +405,12 @@ impl TrainedModel {
         let model = AnyModel::from_params(meta.kind, &meta.spec, n_in, N_FINGERS, params.to_vec())?;
         let normalizer = Normalizer::from_scales(scales.to_vec())?;
         let trained = TrainedModel::new(model, meta.spec, normalizer, chain, meta.summary)?;
-        with_records(trained, meta.verification, meta.rest_rms_uv)
+        with_records(
+            trained,
+            meta.verification,
+            meta.rest_rms_uv,
+            meta.rest_stage,
+        )
     }
 
     /// Writes the model atomically ([`crate::fsio::write_atomic`]: a temporary file in the same

@@ -6,6 +6,8 @@
 //! - [`Normalizer`]: per-feature scale, no centring, so zero input stays zero.
 //! - [`Dataset`] + [`train`]: masked MSE plus the effort-ray penalty ([`EffortPenalty`]), Adam
 //!   or SGD, early stopping on held-out trials, deterministic for a given seed.
+//! - [`RestStage`]: a soft dead zone per finger fitted from the calibration's rest windows, so a
+//!   relaxed hand stays still (monotonic, keeps ±1 at ±1).
 //! - [`TrainedModel`]: what a model file holds ([`TrainedModel::save`] / [`TrainedModel::load`]);
 //!   [`Predictor`] runs it in the daemon's tick.
 //!
@@ -27,6 +29,7 @@ mod linalg;
 mod normalizer;
 mod optim;
 mod resdd;
+mod rest;
 mod spec;
 mod split;
 mod summary;
@@ -46,6 +49,7 @@ pub use file::{FORMAT_VERSION, HEADER_LEN, MAGIC, NORMALIZER_TENSOR};
 pub use kind::ModelKind;
 pub use normalizer::Normalizer;
 pub use resdd::{ResDd, ResDdActivations, RESDD_INPUT_GAIN};
+pub use rest::{RestFit, RestStage, MAX_REST_WIDTH, REST_SHARPNESS};
 pub use spec::{
     CnnSpec, LnSpec, MlpSpec, ModelSpec, ResDdSpec, ResDdVariant, MAX_MODULES, MAX_WIDTH,
 };

@@ -417,11 +417,6 @@ pub fn train(
         n_val_trials: distinct_trials(data, &split.val),
         duration_ms: u64::try_from(started.elapsed().as_millis()).unwrap_or(u64::MAX),
     };
-    Ok(TrainedModel::new(
-        model,
-        *spec,
-        normalizer,
-        data.chain().clone(),
-        summary,
-    )?)
+    let trained = TrainedModel::new(model, *spec, normalizer, data.chain().clone(), summary)?;
+    Ok(super::rest::with_fitted_rest(trained, data, cfg.rest)?)
 }

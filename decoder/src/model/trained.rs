@@ -7,13 +7,15 @@ use super::any::AnyModel;
 use super::dataset::N_FINGERS;
 use super::error::ModelError;
 use super::normalizer::Normalizer;
+use super::rest::RestStage;
 use super::spec::ModelSpec;
 use super::summary::TrainingSummary;
 use super::traits::{Model, Scratch, Trainable};
 use super::verify::VerificationRecord;
 
 /// Model + normalizer + chain configuration + training summary (what a model file holds), and
-/// optionally the verification of its calibration rays and the calibration's rest level.
+/// optionally the verification of its calibration rays, the calibration's rest level and the
+/// rest stage applied to the outputs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainedModel {
     pub(crate) model: AnyModel,
@@ -23,6 +25,7 @@ pub struct TrainedModel {
     pub(crate) summary: TrainingSummary,
     pub(crate) verification: Option<VerificationRecord>,
     pub(crate) rest_rms_uv: Option<Vec<f64>>,
+    pub(crate) rest_stage: Option<RestStage>,
 }
 
 impl TrainedModel {
@@ -77,6 +80,7 @@ impl TrainedModel {
             summary,
             verification: None,
             rest_rms_uv: None,
+            rest_stage: None,
         })
     }
 
@@ -111,6 +115,18 @@ impl TrainedModel {
         }
         self.rest_rms_uv = Some(levels);
         Ok(self)
+    }
+
+    /// The model with `stage` applied to its outputs (see [`RestStage`]), or without a stage.
+    pub fn with_rest_stage(mut self, stage: Option<RestStage>) -> Self {
+        self.rest_stage = stage;
+        self
+    }
+
+    /// The rest stage applied to the model's outputs (None: raw outputs, e.g. a two-point
+    /// calibration, the paper's training or an older file).
+    pub fn rest_stage(&self) -> Option<&RestStage> {
+        self.rest_stage.as_ref()
     }
 
     /// The model.
@@ -159,6 +175,9 @@ impl TrainedModel {
         self.normalizer.apply(features, &mut xn);
         let mut y = [0.0; N_FINGERS];
         self.model.predict(&xn, &mut y);
+        if let Some(stage) = &self.rest_stage {
+            stage.apply(&mut y);
+        }
         y
     }
 
@@ -181,17 +200,20 @@ impl TrainedModel {
         Predictor {
             model: self.model.clone(),
             normalizer: self.normalizer.clone(),
+            rest_stage: self.rest_stage,
             scratch: self.model.new_scratch(),
             xn: vec![0.0; self.normalizer.len()],
         }
     }
 }
 
-/// Runs a trained model on raw feature vectors without allocating: normalize, then predict.
+/// Runs a trained model on raw feature vectors without allocating: normalize, predict, then
+/// the rest stage when the model has one.
 #[derive(Debug, Clone)]
 pub struct Predictor {
     model: AnyModel,
     normalizer: Normalizer,
+    rest_stage: Option<RestStage>,
     scratch: Scratch,
     xn: Vec<f64>,
 }
@@ -211,6 +233,9 @@ impl Predictor {
         self.normalizer.apply(features, &mut self.xn);
         let mut y = [0.0; N_FINGERS];
         self.model.predict_with(&self.xn, &mut y, &mut self.scratch);
+        if let Some(stage) = &self.rest_stage {
+            stage.apply(&mut y);
+        }
         y
     }
 }

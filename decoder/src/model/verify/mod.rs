@@ -7,7 +7,8 @@
 //! trial's direction, `max dir·(y(k1) - y(k2))` over `k1 < k2`, is read at its critical points,
 //! the real roots of `y'` in `[0, 1]`, found by Bernstein subdivision (see `roots.rs`: a
 //! root-free interval is proven root-free, never assumed). The models have no output clamp or
-//! squashing, so the polynomial is the output. MLP and CNN (ReLU) are checked by sampling
+//! squashing; a model with a rest stage ([`crate::model::RestStage`], strictly increasing) is
+//! read through it at the same critical points. MLP and CNN (ReLU) are checked by sampling
 //! [`SAMPLED_POINTS`] efforts and say so. A model file keeps the outcome as a
 //! [`VerificationRecord`].
 
@@ -26,5 +27,5 @@ pub use propagate::{output_degree, var_index, MAX_DEGREE};
 pub use ray::{RayCurves, RayVerifier, SAMPLED_POINTS};
 pub use record::{describe_verification, VerificationRecord, WorstRay};
 pub use report::{verify_windows, TrialFinger, VerifyReport, DEFAULT_TOLERANCE};
-pub use reversal::{exact_reversal, largest_drop, Method, Reversal};
+pub use reversal::{exact_reversal, exact_reversal_through, largest_drop, Method, Reversal};
 pub use roots::{roots_in_unit, Roots, SLOPE_FLOOR, WIDTH_FLOOR};

@@ -3,9 +3,9 @@
 use super::error::VerifyError;
 use super::poly::eval;
 use super::propagate::{check_polynomial, ray_polynomials};
-use super::reversal::{exact_reversal, largest_drop, Method, Reversal};
+use super::reversal::{exact_reversal_through, largest_drop, Method, Reversal};
 use crate::eval::scale_features;
-use crate::model::{Model, ModelKind, Predictor, TrainedModel, N_FINGERS};
+use crate::model::{Model, ModelKind, Predictor, RestStage, TrainedModel, N_FINGERS};
 
 /// Efforts sampled for a model that is not polynomial (MLP, CNN).
 pub const SAMPLED_POINTS: usize = 1001;
@@ -13,8 +13,9 @@ pub const SAMPLED_POINTS: usize = 1001;
 /// A model's outputs along one ray.
 #[derive(Debug, Clone, PartialEq)]
 pub enum RayCurves {
-    /// One polynomial in `k` per finger (power basis).
-    Polynomials(Vec<Vec<f64>>),
+    /// One polynomial in `k` per finger (power basis): the model's raw output, and the rest
+    /// stage the model applies to it (the curve is the stage of the polynomial).
+    Polynomials(Vec<Vec<f64>>, Option<RestStage>),
     /// Outputs at `k = i / (n - 1)`, `i = 0..n`.
     Sampled(Vec<[f64; N_FINGERS]>),
 }
@@ -74,7 +75,10 @@ impl<'m> RayVerifier<'m> {
     pub fn curves(&mut self, features: &[f64]) -> RayCurves {
         assert_eq!(features.len(), self.n_inputs(), "ray feature count");
         match self.method {
-            Method::Exact => RayCurves::Polynomials(ray_polynomials(self.model, features)),
+            Method::Exact => RayCurves::Polynomials(
+                ray_polynomials(self.model, features),
+                self.model.rest_stage().copied(),
+            ),
             Method::Sampled(n) => RayCurves::Sampled(
                 (0..n)
                     .map(|i| self.output_at(features, i as f64 / (n - 1) as f64))
@@ -94,7 +98,13 @@ impl RayCurves {
     /// The worst reversal of `finger`'s output against `dir` (+1 flexion, -1 extension).
     pub fn reversal(&self, finger: usize, dir: f64) -> Reversal {
         match self {
-            RayCurves::Polynomials(p) => exact_reversal(&p[finger], dir),
+            RayCurves::Polynomials(p, None) => exact_reversal_through(&p[finger], dir, &|v| v, 1.0),
+            RayCurves::Polynomials(p, Some(st)) => exact_reversal_through(
+                &p[finger],
+                dir,
+                &|v| st.map(finger, v),
+                st.max_slope(finger),
+            ),
             RayCurves::Sampled(ys) => {
                 let last = (ys.len().max(2) - 1) as f64;
                 let points: Vec<(f64, f64)> = ys
@@ -111,7 +121,8 @@ impl RayCurves {
     /// sample).
     pub fn value(&self, finger: usize, k: f64) -> f64 {
         match self {
-            RayCurves::Polynomials(p) => eval(&p[finger], k),
+            RayCurves::Polynomials(p, None) => eval(&p[finger], k),
+            RayCurves::Polynomials(p, Some(st)) => st.map(finger, eval(&p[finger], k)),
             RayCurves::Sampled(ys) => {
                 let i = (k.clamp(0.0, 1.0) * (ys.len() - 1) as f64).round() as usize;
                 ys[i][finger]

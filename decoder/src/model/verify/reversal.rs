@@ -68,15 +68,22 @@ pub fn largest_drop(points: &[(f64, f64)], dir: f64, method: Method) -> Reversal
 /// (+1: should rise, -1: should fall): between consecutive critical points `y` is monotonic,
 /// so its extremes on `[0, 1]` are among `{0, 1}` and the real roots of `y'` there.
 pub fn exact_reversal(y: &[f64], dir: f64) -> Reversal {
+    exact_reversal_through(y, dir, &|v| v, 1.0)
+}
+
+/// [`exact_reversal`] of `g(y(k))` for a non-decreasing `g` whose slope is at most `slope`
+/// (the rest stage): `g` keeps the order of values, so the extremes of `g∘y` are still among
+/// the critical points of `y`, and the bound grows by `slope`.
+pub fn exact_reversal_through(y: &[f64], dir: f64, g: &dyn Fn(f64) -> f64, slope: f64) -> Reversal {
     let roots = roots_in_unit(&derivative(y));
     let mut ks = roots.points;
     ks.extend([0.0, 1.0]);
     ks.sort_by(f64::total_cmp);
     ks.dedup();
-    let points: Vec<(f64, f64)> = ks.iter().map(|&k| (k, eval(y, k))).collect();
+    let points: Vec<(f64, f64)> = ks.iter().map(|&k| (k, g(eval(y, k)))).collect();
     let mut r = largest_drop(&points, dir, Method::Exact);
     // Each of the two ends may be off by the bound.
-    r.bound = 2.0 * roots.bound;
+    r.bound = 2.0 * roots.bound * slope;
     r
 }
 
