@@ -18,6 +18,9 @@ use handstack_tests::vcan::{TestConfig, VcanEnv};
 /// The protocol: rest, flexion and extension of every finger and of the whole hand, two
 /// rounds (the second lets calibrate compare repetitions), short phases: about 2 minutes.
 const SHORT: &str = "repetitions = 2\nprepare_s = 1.0\nhold_s = 2.0\nrest_s = 3.0\nrelax_s = 1.5\n";
+/// Training's epoch cap: emulation runs training ~50x slower than the host, and the suite's
+/// closed loop needs a usable model, not the best one (early stopping ends near 80 anyway).
+const EPOCHS: &str = "40";
 /// The cued patient runs at least this long (the calibration ends before; it is stopped then).
 const PATIENT_S: f64 = 900.0;
 
@@ -49,6 +52,8 @@ pub(super) fn calibrate_deploy_arm(env: &VcanEnv) -> PathBuf {
             &protocol.display().to_string(),
             "--socket",
             &sock,
+            "--epochs",
+            EPOCHS,
         ],
     );
     let t1 = now_us();
@@ -101,20 +106,28 @@ fn assert_only_the_hold(seen: &[Seen], t0: u64, t1: u64) {
         .into_iter()
         .filter(|s| s.time_us >= first_cue && s.time_us <= t1)
         .collect();
-    let other = during
-        .iter()
-        .filter(|s| s.mode != FingerMode::SafeStop)
-        .count();
+    // The hold is SAFE_STOP; a finger whose controller fell silent (handsim starved under
+    // emulation) gets DISABLED, motor off, by the daemon's lost-finger rule: not a motion
+    // either. Nothing ACTIVE or HOLD.
+    let count = |m: FingerMode| during.iter().filter(|s| s.mode == m).count();
+    let (stop, disabled) = (count(FingerMode::SafeStop), count(FingerMode::Disabled));
     println!(
-        "while calibrating: {} setpoints, {other} not SAFE_STOP",
-        during.len()
+        "while calibrating: {} setpoints, {stop} SAFE_STOP, {disabled} DISABLED (a silent \
+         controller), {} ACTIVE, {} HOLD",
+        during.len(),
+        count(FingerMode::Active),
+        count(FingerMode::Hold)
     );
     assert!(
         during.len() >= 5 * 20 * 60,
         "only {} setpoints while calibrating: is handd sending?",
         during.len()
     );
-    assert_eq!(other, 0, "setpoints other than the hold while calibrating");
+    assert_eq!(
+        stop + disabled,
+        during.len(),
+        "setpoints other than the hold while calibrating"
+    );
 }
 
 /// R² of the tracked finger's force against the 4 s sine, after 4 s of settling (as in
