@@ -129,6 +129,25 @@ impl ControlHandler {
         self.after_swap("rollback", &status, &path, peer, user, false)
     }
 
+    /// The live lines name the model now running, with its file's rest levels (read here, on
+    /// the control thread; a file that no longer reads gives none: they are for display only).
+    fn tell_live(&self, status: &ModelStatus) {
+        let Some(live) = &self.live_model else {
+            return;
+        };
+        let rest_rms_uv = decoder::model::TrainedModel::load(&status.path, None)
+            .ok()
+            .and_then(|m| m.rest_rms_uv().map(<[f64]>::to_vec));
+        *live.lock().unwrap_or_else(|e| e.into_inner()) = crate::control::LiveModel {
+            info: crate::live::ModelInfo {
+                id: status.id.clone(),
+                path: status.path.clone(),
+                kind: status.kind.clone(),
+            },
+            rest_rms_uv,
+        };
+    }
+
     fn restore_config(&self) {
         if let Err(e) = self.config.save_atomic(&self.config_path) {
             tracing::error!(error = %e, "the config could not be restored");
@@ -146,6 +165,7 @@ impl ControlHandler {
         force: bool,
     ) -> Reply {
         self.no_model = false;
+        self.tell_live(status);
         if self.hold == Hold::Calibrating {
             self.hold = Hold::Deployed;
         }

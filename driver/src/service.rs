@@ -37,6 +37,8 @@ pub struct ControlHandler {
     pub(crate) hold: Hold,
     /// Whether the loop runs without a model (until a deploy).
     pub(crate) no_model: bool,
+    /// The live feed's model, replaced on every deploy and rollback.
+    pub(crate) live_model: Option<crate::control::SharedLiveModel>,
 }
 
 impl ControlHandler {
@@ -62,7 +64,15 @@ impl ControlHandler {
             previous: None,
             hold: Hold::Free,
             no_model: false,
+            live_model: None,
         }
+    }
+
+    /// The handler, keeping the live feed's model (`LiveFeed::model`) up to date on deploy and
+    /// rollback.
+    pub fn with_live_model(mut self, live: crate::control::SharedLiveModel) -> Self {
+        self.live_model = Some(live);
+        self
     }
 
     /// The handler, for a loop running the chain `chain` (a deployed model must match it; the

@@ -18,7 +18,7 @@ use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use driver::config::Config;
-use driver::control::{self, ControlServer, LiveFeed, MAX_CONNECTIONS, MAX_SUBSCRIBERS};
+use driver::control::{self, ControlServer, LiveFeed, LiveModel, MAX_CONNECTIONS, MAX_SUBSCRIBERS};
 use driver::daemon::{Runner, Snapshot};
 use driver::engine::{Engine, EngineSettings};
 use driver::live::{Live, ModelInfo};
@@ -83,13 +83,15 @@ impl Daemon {
         let snapshot = runner.snapshot();
         let feed = LiveFeed {
             snapshot: runner.snapshot(),
-            model: ModelInfo {
-                id: "0000beef".into(),
-                path: "model.hsm".into(),
-                kind: "ResDD".into(),
-            },
+            model: Arc::new(std::sync::Mutex::new(LiveModel {
+                info: ModelInfo {
+                    id: "0000beef".into(),
+                    path: "model.hsm".into(),
+                    kind: "ResDD".into(),
+                },
+                rest_rms_uv: None,
+            })),
             tick_us: 50_000,
-            rest_rms_uv: None,
         };
         let mut handler = ControlHandler::new(config.clone(), config_path.clone(), snapshot, tx);
         let server = ControlServer::bind(&config.control.socket, None)

@@ -254,17 +254,21 @@ fn calibrating_hold_deploy_refusals_swap_and_rollback() {
         .unwrap();
     let (tx, rx) = mpsc::sync_channel(driver::service::COMMAND_QUEUE);
     rig.runner.set_commands(rx);
+    let live = std::sync::Arc::new(std::sync::Mutex::new(driver::control::LiveModel::default()));
     let mut handler = ControlHandler::new(
         config.clone(),
         config_path.clone(),
         rig.runner.snapshot(),
         tx,
     )
-    .with_model(loaded.status(&config.model));
+    .with_model(loaded.status(&config.model))
+    .with_live_model(std::sync::Arc::clone(&live));
     let server = ControlServer::bind(&config.control.socket, None).unwrap();
     std::thread::spawn(move || server.serve(move |req, peer| handler.handle(req, peer)));
     let sock = config.control.socket.clone();
     let s = sock.to_str().unwrap();
+    // What the live lines (`handctl monitor`) say of the running model.
+    let live_id = || live.lock().unwrap().info.id.clone();
 
     rig.run_until(2_000_000);
     assert!(heartbeat_ids(&rig, 0).iter().all(|h| h.1 == id_a));
@@ -354,6 +358,7 @@ fn calibrating_hold_deploy_refusals_swap_and_rollback() {
         ids[..first_b].iter().all(|h| h.1 == id_a) && ids[first_b..].iter().all(|h| h.1 == id_b)
     );
     assert!(ids[first_b].0 >= deploy_at);
+    assert_eq!(live_id(), format!("{id_b:08x}"), "the live lines' model");
     // No tick missed: the setpoints of every 50 ms tick are on the bus across the swap.
     let ticks: Vec<u64> = rig
         .setpoints()
@@ -390,6 +395,7 @@ fn calibrating_hold_deploy_refusals_swap_and_rollback() {
         id_a
     );
     assert_eq!(Config::load(&config_path).unwrap().model, config.model);
+    assert_eq!(live_id(), format!("{id_a:08x}"), "the live lines' model");
     let audit = std::fs::read_to_string(dir.join("audit.log")).unwrap();
     for want in [
         "calibrating",

@@ -6,14 +6,14 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::AtomicBool;
-use std::sync::{mpsc, Arc};
+use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use clap::Parser;
 use decoder::dsp::ChainConfig;
 use decoder::model::Model as _;
 use driver::config::{Config, DEFAULT_CONFIG_PATH};
-use driver::control::{ControlServer, LiveFeed};
+use driver::control::{ControlServer, LiveFeed, LiveModel};
 use driver::daemon::Runner;
 use driver::engine::Engine;
 use driver::live::ModelInfo;
@@ -168,26 +168,30 @@ fn run(args: &Args) -> Result<(), String> {
 
     let (tx, rx) = mpsc::sync_channel(COMMAND_QUEUE);
     let mut runner = Runner::new(engine, transport, clock, config.tick_ms * 1000).with_commands(rx);
-    let live = LiveFeed {
-        snapshot: runner.snapshot(),
-        model: ModelInfo {
+    let live_model = Arc::new(Mutex::new(LiveModel {
+        info: ModelInfo {
             id: format!("{:08x}", loaded.as_ref().map_or(0, |l| l.model_id)),
             path: config.model.display().to_string(),
             kind: loaded
                 .as_ref()
                 .map_or("none".into(), |l| l.model.model().kind().to_string()),
         },
-        tick_us: config.tick_ms * 1000,
         rest_rms_uv: loaded
             .as_ref()
             .and_then(|l| l.model.rest_rms_uv().map(<[f64]>::to_vec)),
+    }));
+    let live = LiveFeed {
+        snapshot: runner.snapshot(),
+        model: Arc::clone(&live_model),
+        tick_us: config.tick_ms * 1000,
     };
     let server = ControlServer::bind(&config.control.socket, config.control.group.as_deref())
         .map_err(|e| e.to_string())?
         .with_live(live);
     let mut handler =
         ControlHandler::new(config.clone(), args.config.clone(), runner.snapshot(), tx)
-            .with_chain(chain);
+            .with_chain(chain)
+            .with_live_model(live_model);
     handler = match &loaded {
         Some(l) => handler.with_model(l.status(&config.model)),
         None => handler.without_model(),

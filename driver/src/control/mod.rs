@@ -22,7 +22,8 @@ pub use conn::{REPLY_TIMEOUT, REQUEST_DEADLINE};
 pub use error::ControlError;
 pub use server::{ControlServer, MAX_CONNECTIONS};
 pub use subscribers::{
-    LiveFeed, LIVE_QUEUE, LIVE_SEND_BUFFER, LIVE_WRITE_TIMEOUT, MAX_SUBSCRIBERS,
+    LiveFeed, LiveModel, SharedLiveModel, LIVE_QUEUE, LIVE_SEND_BUFFER, LIVE_WRITE_TIMEOUT,
+    MAX_SUBSCRIBERS,
 };
 
 #[cfg(test)]

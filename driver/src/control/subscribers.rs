@@ -29,23 +29,37 @@ pub const LIVE_WRITE_TIMEOUT: Duration = Duration::from_millis(250);
 /// found within about a second rather than after the kernel's default (hundreds of lines).
 pub const LIVE_SEND_BUFFER: usize = 16 * 1024;
 
+/// Which model runs, as the live lines tell it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct LiveModel {
+    /// The model's id, path and kind.
+    pub info: ModelInfo,
+    /// The model's calibration rest level per channel, µV, when its file carries it.
+    pub rest_rms_uv: Option<Vec<f64>>,
+}
+
+/// The running model's [`LiveModel`], shared by the live feed and the control handler, which
+/// replaces it on every deploy and rollback.
+pub type SharedLiveModel = Arc<Mutex<LiveModel>>;
+
 /// Where the live lines come from.
 #[derive(Clone)]
 pub struct LiveFeed {
     /// The loop's snapshot.
     pub snapshot: SharedSnapshot,
-    /// The model that runs.
-    pub model: ModelInfo,
+    /// The model that runs (the control handler updates it: give it the same handle).
+    pub model: SharedLiveModel,
     /// The loop's tick, µs.
     pub tick_us: u64,
-    /// The model's calibration rest level per channel, µV, when its file carries it.
-    pub rest_rms_uv: Option<Vec<f64>>,
 }
 
 impl std::fmt::Debug for LiveFeed {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("LiveFeed")
-            .field("model", &self.model)
+            .field(
+                "model",
+                &*self.model.lock().unwrap_or_else(|e| e.into_inner()),
+            )
             .field("tick_us", &self.tick_us)
             .finish()
     }
@@ -130,8 +144,8 @@ impl Hub {
             }
             s.due = tick + s.every_ticks;
             let line = line.get_or_insert_with(|| {
-                let live =
-                    Live::from_snapshot(snap, &self.feed.model, self.feed.rest_rms_uv.as_deref());
+                let model = self.feed.model.lock().unwrap_or_else(|e| e.into_inner());
+                let live = Live::from_snapshot(snap, &model.info, model.rest_rms_uv.as_deref());
                 let mut text = serde_json::to_string(&live).unwrap_or_default();
                 text.push('\n');
                 Arc::from(text)

@@ -65,7 +65,10 @@ pub(super) fn calibrate_deploy_arm(env: &VcanEnv) -> PathBuf {
     );
     assert_only_the_hold(&monitor.snapshot(), t0, t1);
     let model = out.join("model.hsm");
-    handctl(env, &["deploy", &model.display().to_string(), "--socket", &sock]);
+    handctl(
+        env,
+        &["deploy", &model.display().to_string(), "--socket", &sock],
+    );
     handctl(env, &["arm", "--socket", &sock]);
     let t_sine = now_us();
     let mut sine = handsim(env, &dir, "handsim-sine", "sine", 25.0, &[]);
