@@ -270,4 +270,9 @@ fn batched_passes_equal_per_sample_passes() {
         let m = AnyModel::random(kind, &ModelSpec::default(), 96, 5, 1).expect("model");
         check_batch(&m, 32, 302);
     }
+    // An odd electrode count (the pool drops the last) and a wider kernel.
+    let mut sp = spec();
+    sp.cnn.kernel = 5;
+    let m = AnyModel::random(ModelKind::Cnn, &sp, 40, 5, 3).expect("model");
+    check_batch(&m, 6, 303);
 }

@@ -21,6 +21,10 @@ pub(crate) struct RayBatch {
     dy: Vec<[f64; N_FINGERS]>,
     ks: Vec<f64>,
     dirs: Vec<[f64; N_FINGERS]>,
+    /// The charged points only (inputs, outputs, scaled gradients), for the backward pass.
+    charged_x: Vec<f64>,
+    charged_y: Vec<f64>,
+    charged_dy: Vec<f64>,
 }
 
 impl RayBatch {
@@ -36,6 +40,9 @@ impl RayBatch {
             dy: vec![[0.0; N_FINGERS]; rows],
             ks: vec![0.0; rows],
             dirs: vec![[0.0; N_FINGERS]; max_rays],
+            charged_x: vec![0.0; rows * n_in],
+            charged_y: vec![0.0; rows * N_FINGERS],
+            charged_dy: vec![0.0; rows * N_FINGERS],
         }
     }
 
@@ -89,13 +96,44 @@ impl RayBatch {
             penalty += charge(y, &mut self.dy[pts], dirs, ks, min_slope);
         }
         if let Some((grad, scale)) = grad {
-            let dy = self.dy[..rows].as_flattened_mut();
-            for d in dy.iter_mut() {
-                *d *= scale;
-            }
-            model.backward_batch(x, dy, work, grad);
+            self.backward_charged(model, rows, work, grad, scale);
         }
         penalty
+    }
+
+    /// Back-propagates `scale` times the output gradients of the points that have one (on a
+    /// trained model most points are not charged): gathers them, reruns their forward pass for
+    /// the activations, then one batched backward pass.
+    fn backward_charged<M: Trainable + ?Sized>(
+        &mut self,
+        model: &M,
+        rows: usize,
+        work: &mut BatchWork,
+        grad: &mut [f64],
+        scale: f64,
+    ) {
+        let n_in = self.n_in;
+        let mut n = 0;
+        for (r, dy) in self.dy[..rows].iter().enumerate() {
+            if dy.iter().all(|&d| d == 0.0) {
+                continue;
+            }
+            let (src, dst) = (r * n_in..(r + 1) * n_in, n * n_in..(n + 1) * n_in);
+            self.charged_x[dst].copy_from_slice(&self.x[src]);
+            for (c, d) in self.charged_dy[n * N_FINGERS..(n + 1) * N_FINGERS]
+                .iter_mut()
+                .zip(dy)
+            {
+                *c = d * scale;
+            }
+            n += 1;
+        }
+        if n == 0 {
+            return;
+        }
+        let x = &self.charged_x[..n * n_in];
+        model.forward_batch(x, &mut self.charged_y[..n * N_FINGERS], work);
+        model.backward_batch(x, &self.charged_dy[..n * N_FINGERS], work, grad);
     }
 }
 

@@ -18,6 +18,7 @@
 mod any;
 mod batch;
 mod cnn;
+mod cnn_batch;
 mod config;
 mod dataset;
 mod dense;
