@@ -4,7 +4,9 @@
 //! Deterministic: one ChaCha8 stream seeded from [`TrainConfig::seed`] makes the split, the
 //! initial weights, and per epoch the shuffle and then the penalty's jittered efforts, in that
 //! order; every sum runs in a fixed order on one thread. The same seed and the same data
-//! therefore give bit-identical weights. Without the penalty no effort is drawn, so the plain
+//! therefore give bit-identical weights on the same machine. Each mini-batch runs as matrix
+//! products ([`super::Trainable::forward_batch`]) whose kernel matrixmultiply picks at run time
+//! (AVX-512, AVX2/FMA, SSE2, NEON): another processor may round differently in the last bits. Without the penalty no effort is drawn, so the plain
 //! training's stream, and its weights, are those from before the penalty existed.
 
 use std::time::Instant;
