@@ -140,7 +140,8 @@ def main():
     median = runs[len(runs) // 2]
     if a.json:
         print(json.dumps({"what": "train_resdd_epoch", "impl": "pytorch",
-                          "ms_cpu_per_epoch": round(median, 4), "epochs": a.epochs}))
+                          "ms_cpu_per_epoch": round(median, 4), "epochs": a.epochs},
+                         separators=(",", ":")))
     else:
         print(f"PyTorch {torch.__version__} ResDD H=96 L=2, {len(train_idx)} train + "
               f"{len(val_idx)} val windows x 96 features, batch 32, Adam, {a.epochs} epochs, "
