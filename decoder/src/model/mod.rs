@@ -11,7 +11,7 @@
 //!
 //! Numbers are `f64` throughout; matrices are row-major plain slices: one flat parameter vector
 //! per model keeps optimizers and the file format uniform and makes it easy to guarantee that
-//! inference never allocates. Inference runs one sample at a time ([`super::model::Model`]);
+//! inference never allocates. Inference runs one sample at a time ([`Model`]);
 //! training runs each mini-batch as matrix products ([`Trainable::forward_batch`],
 //! [`BatchWork`]; nalgebra's `gemm`, see `gemm.rs`).
 
