@@ -213,3 +213,66 @@ fn effort_penalty_gradients() {
         check_effort_penalty(m, 60);
     }
 }
+
+/// The batched passes training uses against the per-sample passes (whose gradients the tests
+/// above check): outputs row by row and the gradient summed over the rows agree to round-off
+/// (the matrix products sum in another order). Small and default shapes, every kind, ResDD at
+/// every depth and both variants, a batch of one and a ragged batch.
+fn check_batch(m: &AnyModel, rows: usize, seed: u64) {
+    let mut g = Gen(seed);
+    let (n_in, n_out) = (m.n_inputs(), m.n_outputs());
+    let x: Vec<f64> = (0..rows * n_in).map(|_| g.next()).collect();
+    let dy: Vec<f64> = (0..rows * n_out).map(|_| g.next()).collect();
+    let mut work = m.new_batch_work(rows);
+    let mut y = vec![f64::NAN; rows * n_out];
+    m.forward_batch(&x, &mut y, &mut work);
+    let mut grad = vec![0.0; m.params().len()];
+    m.backward_batch(&x, &dy, &mut work, &mut grad);
+    let (mut s, mut want_grad) = (m.new_scratch(), vec![0.0; m.params().len()]);
+    let mut yi = vec![0.0; n_out];
+    for r in 0..rows {
+        let xr = &x[r * n_in..(r + 1) * n_in];
+        m.predict_with(xr, &mut yi, &mut s);
+        for (a, b) in y[r * n_out..(r + 1) * n_out].iter().zip(&yi) {
+            assert!(
+                (a - b).abs() <= 1e-12 * (1.0 + b.abs()),
+                "{} row {r}: {a} vs {b}",
+                m.kind()
+            );
+        }
+        m.backward(xr, &dy[r * n_out..(r + 1) * n_out], &mut s, &mut want_grad);
+    }
+    let scale = want_grad.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+    for (i, (a, b)) in grad.iter().zip(&want_grad).enumerate() {
+        assert!(
+            (a - b).abs() <= 1e-12 * scale,
+            "{} grad {i}: {a} vs {b}",
+            m.kind()
+        );
+    }
+}
+
+#[test]
+fn batched_passes_equal_per_sample_passes() {
+    for variant in [ResDdVariant::InputGated, ResDdVariant::Chained] {
+        for modules in 0..=2 {
+            let mut sp = spec();
+            sp.resdd.modules = modules;
+            sp.resdd.variant = variant;
+            let m = AnyModel::random(ModelKind::ResDd, &sp, 11, 5, 3).expect("model");
+            check_batch(&m, 7, 200 + modules as u64);
+        }
+    }
+    for kind in ModelKind::ALL {
+        let m = AnyModel::random(kind, &spec(), 16, 5, 2).expect("model");
+        check_batch(&m, 1, 300);
+        check_batch(&m, 9, 301);
+        let m = AnyModel::random(kind, &ModelSpec::default(), 96, 5, 1).expect("model");
+        check_batch(&m, 32, 302);
+    }
+    // An odd electrode count (the pool drops the last) and a wider kernel.
+    let mut sp = spec();
+    sp.cnn.kernel = 5;
+    let m = AnyModel::random(ModelKind::Cnn, &sp, 40, 5, 3).expect("model");
+    check_batch(&m, 6, 303);
+}

@@ -1,5 +1,6 @@
 //! `AnyModel`: one of the four architectures, chosen at run time (from a CLI flag or a file).
 
+use super::batch::BatchWork;
 use super::cnn::Cnn;
 use super::dense::DenseNet;
 use super::error::ModelError;
@@ -140,6 +141,23 @@ impl Trainable for AnyModel {
             AnyModel::ResDd(m) => m.backward(x, dy, scratch, grad),
             AnyModel::Dense(m) => m.backward(x, dy, scratch, grad),
             AnyModel::Cnn(m) => m.backward(x, dy, scratch, grad),
+        }
+    }
+    fn batch_work_size(&self, rows: usize) -> (usize, usize) {
+        self.inner().batch_work_size(rows)
+    }
+    fn forward_batch(&self, x: &[f64], y: &mut [f64], work: &mut BatchWork) {
+        match self {
+            AnyModel::ResDd(m) => m.forward_batch(x, y, work),
+            AnyModel::Dense(m) => m.forward_batch(x, y, work),
+            AnyModel::Cnn(m) => m.forward_batch(x, y, work),
+        }
+    }
+    fn backward_batch(&self, x: &[f64], dy: &[f64], work: &mut BatchWork, grad: &mut [f64]) {
+        match self {
+            AnyModel::ResDd(m) => m.backward_batch(x, dy, work, grad),
+            AnyModel::Dense(m) => m.backward_batch(x, dy, work, grad),
+            AnyModel::Cnn(m) => m.backward_batch(x, dy, work, grad),
         }
     }
 }

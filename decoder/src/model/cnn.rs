@@ -10,6 +10,7 @@
 //! All layers have biases (PyTorch's default), so zero input does not give exactly zero output.
 //! Initialisation: He-uniform before each ReLU, Glorot for the output layer, biases zero.
 
+use super::batch::BatchWork;
 use super::error::{check_params, ModelError};
 use super::init::SeededRng;
 use super::kind::ModelKind;
@@ -28,22 +29,22 @@ pub struct Cnn {
 
 /// Shapes derived from a spec and the input size.
 #[derive(Debug, Clone, Copy)]
-struct Dims {
+pub(crate) struct Dims {
     /// Electrodes (sequence length).
-    p: usize,
+    pub(crate) p: usize,
     /// Features per electrode (input channels).
-    cin: usize,
-    f1: usize,
-    f2: usize,
-    k: usize,
+    pub(crate) cin: usize,
+    pub(crate) f1: usize,
+    pub(crate) f2: usize,
+    pub(crate) k: usize,
     /// Pooled length.
-    p2: usize,
-    d: usize,
-    n_out: usize,
+    pub(crate) p2: usize,
+    pub(crate) d: usize,
+    pub(crate) n_out: usize,
 }
 
 impl Dims {
-    fn sizes(&self) -> [usize; 8] {
+    pub(crate) fn sizes(&self) -> [usize; 8] {
         [
             self.f1 * self.k * self.cin,
             self.f1,
@@ -162,7 +163,7 @@ impl Cnn {
         })
     }
 
-    fn d(&self) -> Dims {
+    pub(crate) fn d(&self) -> Dims {
         Self::dims(&self.spec, self.n_in, self.n_out).expect("validated at construction")
     }
 
@@ -249,7 +250,7 @@ impl Cnn {
         &self.spec
     }
 
-    fn split(&self) -> [&[f64]; 8] {
+    pub(crate) fn split(&self) -> [&[f64]; 8] {
         let sizes = self.d().sizes();
         let mut out: [&[f64]; 8] = [&[]; 8];
         let mut rest = &self.params[..];
@@ -362,5 +363,15 @@ impl Trainable for Cnn {
         conv_backward(w2, c1, dm.f1, dm.f2, dm.k, d_c2, gw2, gb2, Some(d_c1));
         relu_backward(c1, d_c1);
         conv_backward(w1, x, dm.cin, dm.f1, dm.k, d_c1, gw1, gb1, None);
+    }
+
+    fn batch_work_size(&self, rows: usize) -> (usize, usize) {
+        self.batch_size(rows)
+    }
+    fn forward_batch(&self, x: &[f64], y: &mut [f64], work: &mut BatchWork) {
+        self.forward_rows(x, y, work);
+    }
+    fn backward_batch(&self, x: &[f64], dy: &[f64], work: &mut BatchWork, grad: &mut [f64]) {
+        self.backward_rows(x, dy, work, grad);
     }
 }

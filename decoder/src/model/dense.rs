@@ -8,6 +8,7 @@
 //! Initialisation: LN Glorot-uniform everywhere; MLP He-uniform before each ReLU, Glorot for the
 //! output layer, biases zero.
 
+use super::batch::BatchWork;
 use super::error::{check_params, ModelError};
 use super::init::SeededRng;
 use super::kind::ModelKind;
@@ -191,12 +192,17 @@ impl DenseNet {
         Ok(net)
     }
 
-    fn has_bias(&self) -> bool {
+    /// The two hidden widths.
+    pub(crate) fn hidden(&self) -> [usize; 2] {
+        self.hidden
+    }
+
+    pub(crate) fn has_bias(&self) -> bool {
         Self::is_mlp(self.kind)
     }
 
     /// Slices `(W, b)` of layer `i` (b empty for LN).
-    fn layer(&self, i: usize) -> (&[f64], &[f64]) {
+    pub(crate) fn layer(&self, i: usize) -> (&[f64], &[f64]) {
         let shapes = Self::layer_shapes(self.n_in, self.hidden, self.n_out);
         let mut off = 0;
         for (j, &(r, c)) in shapes.iter().enumerate() {
@@ -307,5 +313,15 @@ impl Trainable for DenseNet {
         if bias {
             axpy(1.0, d1, gb1);
         }
+    }
+
+    fn batch_work_size(&self, rows: usize) -> (usize, usize) {
+        (self.batch_floats(rows), 0)
+    }
+    fn forward_batch(&self, x: &[f64], y: &mut [f64], work: &mut BatchWork) {
+        self.forward_rows(x, y, work);
+    }
+    fn backward_batch(&self, x: &[f64], dy: &[f64], work: &mut BatchWork, grad: &mut [f64]) {
+        self.backward_rows(x, dy, work, grad);
     }
 }

@@ -132,6 +132,23 @@ pub fn ray_penalty<M: Trainable + ?Sized>(
         model.predict_with(&work.x, &mut work.y[j][..model.n_outputs()], scratch);
         work.dy[j] = [0.0; N_FINGERS];
     }
+    let n = ks.len();
+    let penalty = charge(&work.y[..n], &mut work.dy[..n], dirs, ks, min_slope);
+    if let Some((grad, scale)) = grad {
+        backward_points(model, x, ks, work, scratch, grad, scale);
+    }
+    penalty
+}
+
+/// The penalty of one ray from its outputs `y` at the efforts `ks` (one row per effort), adding
+/// `∂P/∂y` to `dy` (same shape); see [`ray_penalty`].
+pub(crate) fn charge(
+    y: &[[f64; N_FINGERS]],
+    dy: &mut [[f64; N_FINGERS]],
+    dirs: &[f64; N_FINGERS],
+    ks: &[f64],
+    min_slope: f64,
+) -> f64 {
     let mut penalty = 0.0;
     for j in 0..ks.len() - 1 {
         let dk = ks[j + 1] - ks[j];
@@ -139,17 +156,14 @@ pub fn ray_penalty<M: Trainable + ?Sized>(
             continue;
         }
         for (f, &s) in dirs.iter().enumerate().filter(|(_, &s)| s != 0.0) {
-            let r = min_slope - s * (work.y[j + 1][f] - work.y[j][f]) / dk;
+            let r = min_slope - s * (y[j + 1][f] - y[j][f]) / dk;
             if r > 0.0 {
                 penalty += dk * r * r;
                 // ∂(dk·r²)/∂y_{j+1} = -2·s·r, ∂/∂y_j = +2·s·r.
-                work.dy[j + 1][f] -= 2.0 * s * r;
-                work.dy[j][f] += 2.0 * s * r;
+                dy[j + 1][f] -= 2.0 * s * r;
+                dy[j][f] += 2.0 * s * r;
             }
         }
-    }
-    if let Some((grad, scale)) = grad {
-        backward_points(model, x, ks, work, scratch, grad, scale);
     }
     penalty
 }

@@ -1,9 +1,10 @@
-//! Dense kernels on row-major slices, shared by every model.
+//! Dense kernels on row-major slices for one sample at a time: the daemon's inference path, and
+//! the per-sample reference the batched training passes ([`super::gemm`]) are tested against.
 //!
-//! Plain slices rather than nalgebra: the daemon's tick must not allocate, the parameters of a
-//! model live in one flat vector (so optimizers treat every model alike), and these loops are
-//! short enough to read. Every function is deterministic (fixed summation order), which the
-//! "same seed, same weights" guarantee relies on.
+//! Plain slices: the daemon's tick must not allocate, the parameters of a model live in one
+//! flat vector (so optimizers treat every model alike), and these loops are short enough to
+//! read. Every function is deterministic (fixed summation order), which the "same seed, same
+//! weights" guarantee relies on.
 
 /// Dot product with eight independent accumulators (enough independent add chains to keep
 /// the vector units busy; fixed order, so results are reproducible).

@@ -11,24 +11,32 @@
 //! - [`TrainedModel`]: what a model file holds ([`TrainedModel::save`] / [`TrainedModel::load`]);
 //!   [`Predictor`] runs it in the daemon's tick.
 //!
-//! Numbers are `f64` throughout; matrices are row-major plain slices (no nalgebra): one flat
-//! parameter vector per model keeps optimizers and the file format uniform and makes it easy to
-//! guarantee that inference never allocates.
+//! Numbers are `f64` throughout; matrices are row-major plain slices: one flat parameter vector
+//! per model keeps optimizers and the file format uniform and makes it easy to guarantee that
+//! inference never allocates. Inference runs one sample at a time ([`Model`]);
+//! training runs each mini-batch as matrix products ([`Trainable::forward_batch`],
+//! [`BatchWork`]; nalgebra's `gemm`, see `gemm.rs`).
 
 mod any;
+mod batch;
 mod cnn;
+mod cnn_batch;
 mod config;
 mod dataset;
 mod dense;
+mod dense_batch;
 mod effort;
+mod effort_batch;
 mod error;
 mod file;
+mod gemm;
 mod init;
 mod kind;
 mod linalg;
 mod normalizer;
 mod optim;
 mod resdd;
+mod resdd_batch;
 mod rest;
 mod spec;
 mod split;
@@ -39,6 +47,7 @@ mod traits;
 pub mod verify;
 
 pub use any::AnyModel;
+pub use batch::BatchWork;
 pub use cnn::Cnn;
 pub use config::{Optimizer, TrainConfig, ValidationSplit};
 pub use dataset::{Dataset, N_FINGERS};

@@ -6,6 +6,7 @@
 //! multiplicative term, so with small `X` the model is close to linear; initialisation keeps
 //! `X` small (see [`ResDd::random`]) so training starts from a near-linear map.
 
+use super::batch::BatchWork;
 use super::error::{check_params, ModelError};
 use super::init::SeededRng;
 use super::kind::ModelKind;
@@ -131,7 +132,7 @@ impl ResDd {
         ResDdActivations::over(h, l, &scratch.buf)
     }
 
-    fn split_params(&self) -> (&[f64], &[f64], &[f64]) {
+    pub(crate) fn split_params(&self) -> (&[f64], &[f64], &[f64]) {
         let h = self.spec.hidden;
         let (w_in, rest) = self.params.split_at(h * self.n_in);
         let (w_mods, w_out) = rest.split_at(self.spec.modules * h * h);
@@ -233,6 +234,16 @@ impl Trainable for ResDd {
             *dx += da;
         }
         outer_acc(g_in, d.x, x);
+    }
+
+    fn batch_work_size(&self, rows: usize) -> (usize, usize) {
+        (self.batch_floats(rows), 0)
+    }
+    fn forward_batch(&self, x: &[f64], y: &mut [f64], work: &mut BatchWork) {
+        self.forward_rows(x, y, work);
+    }
+    fn backward_batch(&self, x: &[f64], dy: &[f64], work: &mut BatchWork, grad: &mut [f64]) {
+        self.backward_rows(x, dy, work, grad);
     }
 }
 

@@ -4,15 +4,19 @@
 //! Deterministic: one ChaCha8 stream seeded from [`TrainConfig::seed`] makes the split, the
 //! initial weights, and per epoch the shuffle and then the penalty's jittered efforts, in that
 //! order; every sum runs in a fixed order on one thread. The same seed and the same data
-//! therefore give bit-identical weights. Without the penalty no effort is drawn, so the plain
+//! therefore give bit-identical weights on the same machine. Each mini-batch runs as matrix
+//! products ([`super::Trainable::forward_batch`]) whose kernel matrixmultiply picks at run time
+//! (AVX-512, AVX2/FMA, SSE2, NEON): another processor may round differently in the last bits. Without the penalty no effort is drawn, so the plain
 //! training's stream, and its weights, are those from before the penalty existed.
 
 use std::time::Instant;
 
 use super::any::AnyModel;
+use super::batch::BatchWork;
 use super::config::TrainConfig;
 use super::dataset::{Dataset, N_FINGERS};
-use super::effort::{ray_directions, ray_penalty, EffortPenalty, RayWork};
+use super::effort::{ray_directions, EffortPenalty};
+use super::effort_batch::RayBatch;
 use super::error::TrainError;
 use super::init::SeededRng;
 use super::kind::ModelKind;
@@ -22,7 +26,7 @@ use super::spec::ModelSpec;
 use super::split::{make_split, Split};
 use super::summary::TrainingSummary;
 use super::trained::TrainedModel;
-use super::traits::{Model, Scratch, Trainable};
+use super::traits::{Model, Trainable};
 
 /// Progress after one epoch, passed to the caller's callback (which decides how to show it).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -65,42 +69,61 @@ impl<'d> Normalized<'d> {
         let nf = self.data.n_features();
         &self.xn[i * nf..(i + 1) * nf]
     }
+
+    /// Copies the normalized features of windows `idx` into the first rows of `out`, one
+    /// window per row, and returns those rows.
+    fn gather<'o>(&self, idx: &[usize], out: &'o mut [f64]) -> &'o [f64] {
+        let nf = self.data.n_features();
+        let rows = &mut out[..idx.len() * nf];
+        for (row, &i) in rows.chunks_exact_mut(nf).zip(idx) {
+            row.copy_from_slice(self.x(i));
+        }
+        rows
+    }
 }
 
-/// What the mini-batch steps reuse: optimizer state, the gradient, and the buffers of the
-/// forward and backward passes.
+/// What the mini-batch steps reuse, sized once for the largest batch: optimizer state, the
+/// gradient, and the buffers of the batched forward and backward passes.
 struct Workspace {
     opt: OptimState,
     grad: Vec<f64>,
-    scratch: Scratch,
-    y: [f64; N_FINGERS],
-    dy: [f64; N_FINGERS],
+    /// Windows per batch (validation runs in chunks of this size too).
+    batch: usize,
+    work: BatchWork,
+    /// A batch's normalized features, one window per row.
+    x: Vec<f64>,
+    y: Vec<[f64; N_FINGERS]>,
+    dy: Vec<[f64; N_FINGERS]>,
     /// The penalty's settings and buffers, when it is on.
     effort: Option<EffortWork>,
 }
 
-/// The effort penalty's settings and per-ray buffers.
+/// The effort penalty's settings and the batch's rays.
 struct EffortWork {
     cfg: EffortPenalty,
     jitter: Vec<f64>,
     ks: Vec<f64>,
-    ray: RayWork,
+    rays: RayBatch,
 }
 
 impl Workspace {
     fn new(model: &AnyModel, cfg: &TrainConfig) -> Self {
         let n_params = model.params().len();
+        let batch = cfg.batch_size;
+        let ray_rows = cfg.effort.map_or(0, |e| batch * (e.points + 2));
         Workspace {
             opt: OptimState::new(cfg.optimizer, n_params),
             grad: vec![0.0; n_params],
-            scratch: model.new_scratch(),
-            y: [0.0; N_FINGERS],
-            dy: [0.0; N_FINGERS],
+            batch,
+            work: model.new_batch_work(batch.max(ray_rows)),
+            x: vec![0.0; batch * model.n_inputs()],
+            y: vec![[0.0; N_FINGERS]; batch],
+            dy: vec![[0.0; N_FINGERS]; batch],
             effort: cfg.effort.map(|e| EffortWork {
                 cfg: e,
                 jitter: vec![0.0; e.points],
                 ks: vec![0.0; e.points + 2],
-                ray: RayWork::new(model.n_inputs(), e.points + 2),
+                rays: RayBatch::new(model.n_inputs(), e.points + 2, batch),
             }),
         }
     }
@@ -148,18 +171,21 @@ struct Outcome {
     best_val_loss: Option<f64>,
 }
 
-/// Masked MSE of `model` over windows `idx`.
-fn masked_mse(model: &AnyModel, set: &Normalized<'_>, idx: &[usize], scratch: &mut Scratch) -> f64 {
-    let mut y = [0.0; N_FINGERS];
+/// Masked MSE of `model` over windows `idx` (batched forward passes, in chunks of a batch).
+fn masked_mse(model: &AnyModel, set: &Normalized<'_>, idx: &[usize], ws: &mut Workspace) -> f64 {
     let (mut sum, mut count) = (0.0, 0usize);
-    for &i in idx {
-        model.predict_with(set.x(i), &mut y, scratch);
-        let (t, m) = (set.data.target(i), set.data.mask(i));
-        for f in 0..N_FINGERS {
-            if m[f] {
-                let e = y[f] - t[f];
-                sum += e * e;
-                count += 1;
+    for chunk in idx.chunks(ws.batch) {
+        let x = set.gather(chunk, &mut ws.x);
+        let y = &mut ws.y[..chunk.len()];
+        model.forward_batch(x, y.as_flattened_mut(), &mut ws.work);
+        for (&i, y) in chunk.iter().zip(y.iter()) {
+            let (t, m) = (set.data.target(i), set.data.mask(i));
+            for f in 0..N_FINGERS {
+                if m[f] {
+                    let e = y[f] - t[f];
+                    sum += e * e;
+                    count += 1;
+                }
             }
         }
     }
@@ -179,30 +205,24 @@ fn validation_loss(
     idx: &[usize],
     ws: &mut Workspace,
 ) -> f64 {
-    let mse = masked_mse(model, set, idx, &mut ws.scratch);
+    let mse = masked_mse(model, set, idx, ws);
     let Some(e) = ws.effort.as_mut() else {
         return mse;
     };
     e.jitter.fill(0.5);
     e.cfg.efforts(&e.jitter, &mut e.ks);
     let (mut penalty, mut count) = (0.0, 0usize);
-    for &i in idx {
-        let (t, m) = (set.data.target(i), set.data.mask(i));
-        count += m.iter().filter(|&&b| b).count();
-        let dirs = ray_directions(t, m);
-        if dirs.iter().any(|&d| d != 0.0) {
-            let (x, ks) = (set.x(i), &e.ks);
-            penalty += ray_penalty(
-                model,
-                x,
-                &dirs,
-                ks,
-                e.cfg.min_slope,
-                &mut e.ray,
-                &mut ws.scratch,
-                None,
-            );
+    for chunk in idx.chunks(ws.batch) {
+        e.rays.clear();
+        for &i in chunk {
+            let (t, m) = (set.data.target(i), set.data.mask(i));
+            count += m.iter().filter(|&&b| b).count();
+            let dirs = ray_directions(t, m);
+            if dirs.iter().any(|&d| d != 0.0) {
+                e.rays.push(set.x(i), &dirs, &e.ks);
+            }
         }
+        penalty += e.rays.run(model, e.cfg.min_slope, &mut ws.work, None);
     }
     mse + e.cfg.weight * penalty / count.max(1) as f64
 }
@@ -247,23 +267,24 @@ fn batch_gradient(
     rng: &mut SeededRng,
 ) {
     ws.grad.fill(0.0);
-    let loss_sum = &mut sums.loss;
-    for &i in batch {
-        let x = set.x(i);
-        model.predict_with(x, &mut ws.y, &mut ws.scratch);
+    let x = set.gather(batch, &mut ws.x);
+    let (y, dy) = (&mut ws.y[..batch.len()], &mut ws.dy[..batch.len()]);
+    model.forward_batch(x, y.as_flattened_mut(), &mut ws.work);
+    for ((&i, y), dy) in batch.iter().zip(y.iter()).zip(dy.iter_mut()) {
         let (t, m) = (set.data.target(i), set.data.mask(i));
         for f in 0..N_FINGERS {
             if m[f] {
-                let e = ws.y[f] - t[f];
-                *loss_sum += e * e;
-                ws.dy[f] = 2.0 * e * inv;
+                let e = y[f] - t[f];
+                sums.loss += e * e;
+                dy[f] = 2.0 * e * inv;
             } else {
-                ws.dy[f] = 0.0;
+                dy[f] = 0.0;
             }
         }
-        model.backward(x, &ws.dy, &mut ws.scratch, &mut ws.grad);
     }
+    model.backward_batch(x, dy.as_flattened(), &mut ws.work, &mut ws.grad);
     if let Some(e) = ws.effort.as_mut() {
+        e.rays.clear();
         for &i in batch {
             let dirs = ray_directions(set.data.target(i), set.data.mask(i));
             if dirs.iter().all(|&d| d == 0.0) {
@@ -273,18 +294,10 @@ fn batch_gradient(
                 *u = rng.unit();
             }
             e.cfg.efforts(&e.jitter, &mut e.ks);
-            let grad = Some((&mut ws.grad[..], e.cfg.weight * inv));
-            sums.penalty += ray_penalty(
-                model,
-                set.x(i),
-                &dirs,
-                &e.ks,
-                e.cfg.min_slope,
-                &mut e.ray,
-                &mut ws.scratch,
-                grad,
-            );
+            e.rays.push(set.x(i), &dirs, &e.ks);
         }
+        let grad = Some((&mut ws.grad[..], e.cfg.weight * inv));
+        sums.penalty += e.rays.run(model, e.cfg.min_slope, &mut ws.work, grad);
     }
 }
 

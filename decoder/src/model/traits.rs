@@ -1,6 +1,7 @@
 //! The interface every architecture implements: inference without allocation, and the flat
 //! parameter vector plus analytic gradient that training and gradient checks use.
 
+use super::batch::BatchWork;
 use super::kind::ModelKind;
 
 /// Work memory for one forward (and backward) pass of one model.
@@ -120,7 +121,46 @@ pub trait Trainable: Model {
     /// Must follow a [`Model::predict_with`] on the same `x` with the same `scratch`, whose
     /// activations it reads (backward buffers also live in `scratch`).
     fn backward(&self, x: &[f64], dy: &[f64], scratch: &mut Scratch, grad: &mut [f64]);
+
+    /// Floats and indices of [`BatchWork`] a batched pass over `rows` samples needs (the
+    /// per-sample fallback needs none besides its scratch).
+    fn batch_work_size(&self, rows: usize) -> (usize, usize) {
+        let _ = rows;
+        (0, 0)
+    }
+
+    /// Work memory for batched passes of up to `rows` samples.
+    fn new_batch_work(&self, rows: usize) -> BatchWork {
+        let (f, i) = self.batch_work_size(rows);
+        BatchWork::with_capacity(f, i, self.new_scratch())
+    }
+
+    /// `y = f(x)` for `rows = x.len() / n_inputs` samples at once (`x` and `y` row-major, one
+    /// sample per row), keeping the activations in `work` for [`Trainable::backward_batch`].
+    /// Equals [`Model::predict_with`] row by row up to summation order (last bits). The
+    /// default runs one sample at a time.
+    fn forward_batch(&self, x: &[f64], y: &mut [f64], work: &mut BatchWork) {
+        let (n_in, n_out) = (self.n_inputs(), self.n_outputs());
+        for (xi, yi) in x.chunks_exact(n_in).zip(y.chunks_exact_mut(n_out)) {
+            self.predict_with(xi, yi, &mut work.scratch);
+        }
+    }
+
+    /// Accumulates `Σ_rows ∂L/∂θ` into `grad` given `dy` (one row of `∂L/∂y` per sample). Must
+    /// follow a [`Trainable::forward_batch`] on the same `x` with the same `work`. The default
+    /// reruns each sample's forward pass, then its [`Trainable::backward`].
+    fn backward_batch(&self, x: &[f64], dy: &[f64], work: &mut BatchWork, grad: &mut [f64]) {
+        let (n_in, n_out) = (self.n_inputs(), self.n_outputs());
+        let mut y = [0.0; MAX_BATCH_FALLBACK_OUT];
+        for (xi, di) in x.chunks_exact(n_in).zip(dy.chunks_exact(n_out)) {
+            self.predict_with(xi, &mut y[..n_out], &mut work.scratch);
+            self.backward(xi, di, &mut work.scratch, grad);
+        }
+    }
 }
+
+/// Most outputs the per-sample fallback of [`Trainable::backward_batch`] supports.
+const MAX_BATCH_FALLBACK_OUT: usize = super::spec::MAX_WIDTH;
 
 /// Asserts the input/output lengths of a pass (cheap; catches wiring errors loudly).
 #[inline]
