@@ -185,6 +185,7 @@ fn train_and_summarize(dir: &Path) {
     let opts = crate::args::TrainingOpts {
         two_point: false,
         plain: false,
+        no_rest_stage: false,
         paper_masks: false,
         seed: 0,
         epochs: 200,
