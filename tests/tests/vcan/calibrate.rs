@@ -16,16 +16,16 @@ use handstack_tests::vcan::{scenario_start_us, setpoints_of, statuses_of, Monito
 use handstack_tests::vcan::{TestConfig, VcanEnv};
 
 /// The protocol: rest, flexion and extension of every finger and of the whole hand, two
-/// rounds (the second lets calibrate compare repetitions), short phases: about 2 minutes.
-const SHORT: &str = "repetitions = 2\nprepare_s = 1.0\nhold_s = 2.0\nrest_s = 3.0\nrelax_s = 1.5\n";
+/// rounds (the second lets calibrate compare repetitions), short phases: about 90 s.
+const SHORT: &str = "repetitions = 2\nprepare_s = 0.5\nhold_s = 2.0\nrest_s = 2.0\nrelax_s = 1.0\n";
 /// Training's epoch cap: emulation runs training ~50x slower than the host, and the suite's
 /// closed loop needs a usable model, not the best one (early stopping ends near 80 anyway).
 const EPOCHS: &str = "40";
 /// The cued patient runs at least this long (the calibration ends before; it is stopped then).
 const PATIENT_S: f64 = 900.0;
 
-/// Runs the workflow in a scratch directory and returns the calibration's directory
-/// (`session/`, `model.hsm`), after asserting what issue 14 asks of it.
+/// Runs the workflow in a scratch directory and returns calibrate's `--out` directory (the
+/// session's files and the trained `model.hsm`), after asserting what issue 14 asks of it.
 pub(super) fn calibrate_deploy_arm(env: &VcanEnv) -> PathBuf {
     let dir = env.scratch("calibrate");
     // No model file: handd starts SAFE with `no_model` and waits for a deploy.

@@ -84,8 +84,8 @@ fn calibration(env: &VcanEnv) -> &'static Path {
             }
             return m;
         }
-        CalibrationSource::CalibrateInto(d) => Some(d),
-        CalibrationSource::Here => None,
+        CalibrationSource::CalibrateInto(d) => d,
+        CalibrationSource::Here => env.scratch("calibration"),
     };
     if let Some(m) = MODEL.get() {
         return m;
@@ -94,28 +94,32 @@ fn calibration(env: &VcanEnv) -> &'static Path {
         !CALIBRATION_TRIED.swap(true, std::sync::atomic::Ordering::SeqCst),
         "the calibration over the bus failed in an earlier test (see a_calibrate_...)"
     );
+    // calibrate's `--out` directory is the session, with the trained `model.hsm` in it; the
+    // layout every test reads is `DIR/session/` beside `DIR/model.hsm`.
     let cal = calibrate::calibrate_deploy_arm(env);
-    let model = match into {
-        Some(d) => {
-            std::fs::create_dir_all(&d).expect("HANDSTACK_CALIBRATE_INTO directory");
-            copy_dir(&cal.join("session"), &d.join("session"));
-            std::fs::copy(cal.join("model.hsm"), d.join("model.hsm")).expect("copy the model");
-            d.join("model.hsm")
-        }
-        None => cal.join("model.hsm"),
-    };
+    std::fs::create_dir_all(&into).expect("the calibration's directory");
+    copy_session(&cal, &into.join("session"));
+    let model = into.join("model.hsm");
+    std::fs::copy(cal.join("model.hsm"), &model).expect("copy the model");
     MODEL.get_or_init(|| model)
 }
 
-/// Copies the files of directory `from` (one level) into `to`.
-fn copy_dir(from: &Path, to: &Path) {
+/// Copies the session's files (one level, the model left out) from `from` into `to`.
+fn copy_session(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).expect("create the copy's directory");
-    for e in std::fs::read_dir(from).expect("read the session directory") {
+    let mut copied = 0;
+    for e in std::fs::read_dir(from).unwrap_or_else(|e| panic!("read {}: {e}", from.display())) {
         let e = e.expect("a directory entry");
-        if e.path().is_file() {
+        if e.path().is_file() && e.file_name() != "model.hsm" {
             std::fs::copy(e.path(), to.join(e.file_name())).expect("copy a session file");
+            copied += 1;
         }
     }
+    assert!(
+        to.join("session.toml").is_file(),
+        "{} holds no session.toml ({copied} files copied)",
+        from.display()
+    );
 }
 
 #[test]
