@@ -18,7 +18,7 @@ use handstack_tests::vcan::{TestConfig, VcanEnv};
 /// The protocol: rest, flexion and extension of every finger and of the whole hand, two
 /// rounds (the second lets calibrate compare repetitions), short phases: about 2.5 minutes
 /// (shorter relax and rest phases, 0.5 s prepare, gave a model that tracked the sine at R² 0.60
-/// instead of 0.92 in one VM run: the patient's 500 ms relax ramp leaks into the next trial).
+/// instead of 0.92 in one VM run; one run each, so the cause is not established).
 const SHORT: &str = "repetitions = 2\nprepare_s = 1.0\nhold_s = 2.0\nrest_s = 3.0\nrelax_s = 1.5\n";
 /// Training's epoch cap: emulation runs training ~50x slower than the host, and the suite's
 /// closed loop needs a usable model, not the best one (early stopping ends near 80 anyway).
