@@ -9,7 +9,8 @@ mod dsp_common;
 
 use decoder::dsp::npy::read_npy;
 use decoder::dsp::{
-    batch_features, batch_filtered, multichannel_features_into, ChainConfig, FeatureSignal, Sos,
+    batch_features, batch_filtered, multichannel_features_into, multichannel_features_with,
+    ChainConfig, FeatureSignal, Simd, Sos,
 };
 use dsp_common::{data_path, rel_err, run_reference, temp_dir};
 use serde_json::Value;
@@ -248,10 +249,19 @@ fn features_only_path_matches_libemg_definitions() {
     // LibEMG feature k is our feature OURS[k] times SCALE[k].
     const OURS: [usize; 6] = [0, 1, 2, 4, 5, 6];
     let scale = [1.0, 1.0, (nf - 1.0) / nf, 1.0, 1.0, 1.0];
-    let mut feats = vec![0.0; 8 * ch];
+    let (mut feats, mut portable) = (vec![0.0; 8 * ch], vec![0.0; 8 * ch]);
     let mut worst = 0.0f64;
     for (i, w) in windows.chunks_exact(ch * len).enumerate() {
         multichannel_features_into(w, ch, &mut feats);
+        // The build for this CPU's instruction set and the portable one: the same bits.
+        multichannel_features_with(Simd::portable(), w, ch, &mut portable);
+        assert!(
+            feats
+                .iter()
+                .zip(&portable)
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "window {i}: dispatched {feats:?} vs portable {portable:?}"
+        );
         for (k, (&o, s)) in OURS.iter().zip(scale).enumerate() {
             for c in 0..ch {
                 let want = theirs[(i * 6 + k) * ch + c];

@@ -2,7 +2,8 @@
 
 use super::config::{ChainSettings, FeatureSignal};
 use super::faults::{Faults, MAX_ABS_SAMPLE};
-use super::features::{features_into, FEATURES_PER_CHANNEL};
+use super::features::strided_features_into;
+use super::simd::Simd;
 
 /// Filter state smaller than this is set to exactly 0 (every `FLUSH_EVERY` samples). Without
 /// it a silent channel's IIR state decays into subnormal numbers and stays there in a limit
@@ -52,11 +53,20 @@ pub struct Chain {
     /// filtered output.
     last_filtered: Vec<f64>,
     faults: Faults,
+    /// The build of the filter and feature loops that runs (same bits either way).
+    simd: Simd,
 }
 
 impl Chain {
-    /// A chain in reset state for `settings` (which it shares, not copies).
+    /// A chain in reset state for `settings` (which it shares, not copies), its loops built for
+    /// the instruction set detected at run time ([`Simd::detect`]).
     pub fn new(settings: &ChainSettings) -> Chain {
+        Chain::with_simd(settings, Simd::detect())
+    }
+
+    /// [`Chain::new`] with the build of the inner loops chosen by `simd`; every choice gives
+    /// the same bits ([`Simd::portable`] is the reference the tests compare against).
+    pub fn with_simd(settings: &ChainSettings, simd: Simd) -> Chain {
         let n_channels = settings.n_channels();
         let n_state = n_channels * settings.cascade().len();
         let window_len = settings.window_len();
@@ -76,6 +86,7 @@ impl Chain {
             features: vec![0.0; settings.n_features()],
             last_filtered: vec![0.0; n_channels],
             faults: Faults::new(n_channels, window_len),
+            simd,
         }
     }
 
@@ -190,14 +201,12 @@ impl Chain {
     /// Meaningful once [`Chain::samples_seen`] reaches the window length (the older part of the
     /// window is zeros before). No allocation.
     pub fn features(&mut self) -> &[f64] {
-        let w = self.window_len;
-        for ch in 0..self.n_channels {
-            let start = ch * 2 * w + self.head;
-            features_into(
-                &self.ring[start..start + w],
-                &mut self.features[ch * FEATURES_PER_CHANNEL..(ch + 1) * FEATURES_PER_CHANNEL],
-            );
-        }
+        let (w, head) = (self.window_len, self.head);
+        let (ring, features) = (&self.ring, &mut self.features);
+        self.simd.run(
+            #[inline(always)]
+            || strided_features_into(ring, 2 * w, head, w, features),
+        );
         &self.features
     }
 

@@ -59,9 +59,11 @@ mod chain;
 mod config;
 mod design;
 mod faults;
+mod feature_passes;
 mod features;
 mod front_end;
 pub mod npy;
+mod simd;
 mod sos;
 
 pub use batch::{batch_features, batch_filtered, try_batch_features, BatchError, FeatureMatrix};
@@ -73,7 +75,9 @@ pub use config::{
 pub use design::{butter_bandpass, dc_highpass, iirnotch};
 pub use faults::{Faults, MAX_ABS_SAMPLE};
 pub use features::{
-    multichannel_features_into, window_features, FEATURES_PER_CHANNEL, FEATURE_NAMES, RMS_FEATURE,
+    multichannel_features_into, multichannel_features_with, window_features, FEATURES_PER_CHANNEL,
+    FEATURE_NAMES, RMS_FEATURE,
 };
 pub use front_end::{default_band_high_hz, FrontEnd, FrontEndChain, NYQUIST_FRACTION};
+pub use simd::Simd;
 pub use sos::Sos;
