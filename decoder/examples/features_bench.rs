@@ -26,10 +26,11 @@ const PASSES: usize = 20;
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let json = args.iter().any(|a| a == "--json");
-    let simd = if args.iter().any(|a| a == "--portable") {
-        Simd::portable()
+    let portable = args.iter().any(|a| a == "--portable");
+    let (simd, name) = if portable {
+        (Simd::portable(), "handstack-portable")
     } else {
-        Simd::detect()
+        (Simd::detect(), "handstack")
     };
     let Some(path) = args.iter().find(|a| !a.starts_with("--")) else {
         eprintln!("usage: features_bench WINDOWS.npy [--json] [--portable]");
@@ -63,11 +64,11 @@ fn main() {
     let (median, best) = (us(rounds[ROUNDS / 2]), us(rounds[0]));
     if json {
         println!(
-            "{{\"what\":\"features_window\",\"impl\":\"handstack\",\"us_cpu_per_window\":{median:.4},\"us_cpu_best\":{best:.4},\"windows\":{n_windows},\"channels\":{channels},\"samples\":{samples}}}"
+            "{{\"what\":\"features_window\",\"impl\":\"{name}\",\"us_cpu_per_window\":{median:.4},\"us_cpu_best\":{best:.4},\"windows\":{n_windows},\"channels\":{channels},\"samples\":{samples}}}"
         );
     } else {
         println!(
-            "handstack features of one {channels} x {samples} window: median {median:.3} us CPU (best {best:.3}) over {ROUNDS} rounds of {} calls",
+            "{name} features of one {channels} x {samples} window: median {median:.3} us CPU (best {best:.3}) over {ROUNDS} rounds of {} calls",
             PASSES * n_windows
         );
     }
