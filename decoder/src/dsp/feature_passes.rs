@@ -90,15 +90,42 @@ pub(super) fn first_pass(x: &[f64]) -> FirstPass {
     acc
 }
 
+/// The first pass over `x` beside the second pass over `prev`, the window before it (of the
+/// same length, at least 2), whose mean is `prev_mean`: `x`'s first-pass sums and `prev`'s sum
+/// of squared deviations. One loop for both, so the single add chain of the second pass runs
+/// next to the first pass's independent work instead of bounding its own loop.
+#[inline(always)]
+pub(super) fn first_pass_beside(x: &[f64], prev: &[f64], prev_mean: f64) -> (FirstPass, f64) {
+    let full = whole_chunks(x.len());
+    let now = &x.as_chunks().0[..full];
+    let next = &x[1..].as_chunks().0[..full];
+    let before = &prev.as_chunks().0[..full];
+    let mut acc = FirstPass::default();
+    let mut ss = [0.0; LANES];
+    for ((p, q), b) in now.iter().zip(next).zip(before) {
+        acc.add_chunk(p, q);
+        add_chunk_squared_deviations(&mut ss, b, prev_mean);
+    }
+    acc.add_tail(x, full * LANES);
+    add_squared_deviations(&mut ss, prev, prev_mean, full);
+    (acc, lane_sum(ss))
+}
+
+/// Adds `(c[l] - mean)^2` to lane `l`.
+#[inline(always)]
+fn add_chunk_squared_deviations(ss: &mut [f64; LANES], c: &[f64; LANES], mean: f64) {
+    for l in 0..LANES {
+        let d = c[l] - mean;
+        ss[l] += d * d;
+    }
+}
+
 /// Adds `(x[i] - mean)^2` for `i >= 4 * from_chunk` to the lanes `ss`.
 #[inline(always)]
 fn add_squared_deviations(ss: &mut [f64; LANES], x: &[f64], mean: f64, from_chunk: usize) {
     let (chunks, rest) = x.as_chunks::<LANES>();
     for c in &chunks[from_chunk.min(chunks.len())..] {
-        for l in 0..LANES {
-            let d = c[l] - mean;
-            ss[l] += d * d;
-        }
+        add_chunk_squared_deviations(ss, c, mean);
     }
     for (l, &v) in rest.iter().enumerate() {
         let d = v - mean;

@@ -1,6 +1,8 @@
 //! The 8 amplitude features of the paper's Table 1 over one window of one channel.
 
-use super::feature_passes::{first_pass, lane_sum, squared_deviations, FirstPass};
+use super::feature_passes::{
+    first_pass, first_pass_beside, lane_sum, squared_deviations, FirstPass,
+};
 use super::simd::Simd;
 
 /// Features per channel.
@@ -76,16 +78,6 @@ struct Stats {
 }
 
 impl Stats {
-    /// Statistics of the window `x` (at least 2 samples): the first pass (sums of x and of
-    /// its differences), then the squared deviations from the mean (see
-    /// [`super::feature_passes`]). Allocation-free.
-    #[inline(always)]
-    fn of(x: &[f64]) -> Stats {
-        let nf = x.len() as f64;
-        let first = first_pass(x);
-        Stats::new(nf, &first, squared_deviations(x, lane_sum(first.sum) / nf))
-    }
-
     /// The statistics from the first pass and the squared deviations `m2`.
     #[inline(always)]
     fn new(nf: f64, first: &FirstPass, m2: f64) -> Stats {
@@ -135,8 +127,29 @@ pub(crate) fn strided_features_into(
         return;
     }
     let window = |c: usize| &data[c * stride + offset..c * stride + offset + len];
-    for (c, o) in out.chunks_exact_mut(FEATURES_PER_CHANNEL).enumerate() {
-        Stats::of(window(c)).features_into(o);
+    let nf = len as f64;
+    let mean = |first: &FirstPass| lane_sum(first.sum) / nf;
+    // Window c's first pass runs beside window c - 1's second pass (see `first_pass_beside`).
+    let mut prev: Option<FirstPass> = None;
+    let n_windows = out.len() / FEATURES_PER_CHANNEL;
+    let mut outs = out.chunks_exact_mut(FEATURES_PER_CHANNEL);
+    for c in 0..n_windows {
+        let x = window(c);
+        let first = match prev {
+            None => first_pass(x),
+            Some(p) => {
+                let (first, m2) = first_pass_beside(x, window(c - 1), mean(&p));
+                if let Some(o) = outs.next() {
+                    Stats::new(nf, &p, m2).features_into(o);
+                }
+                first
+            }
+        };
+        prev = Some(first);
+    }
+    if let (Some(p), Some(o)) = (prev, outs.next()) {
+        let m2 = squared_deviations(window(n_windows - 1), mean(&p));
+        Stats::new(nf, &p, m2).features_into(o);
     }
 }
 
