@@ -53,6 +53,11 @@
 //! large) samples are counted per channel in [`Faults`], reset that channel's filter state and
 //! enter the filter as 0, so a channel recovers as soon as the bad samples leave the window.
 //! [`batch_features`] runs the very same streaming code over a whole recording.
+//!
+//! The filter and feature loops are portable Rust compiled twice: for the baseline target and,
+//! chosen at run time, for AVX2 on x86_64 ([`Simd`]; the `pulp` crate's safe dispatch). Both
+//! builds give the same bits (no reassociation, no fused multiply-add; tested), so the daemon,
+//! training and replay agree whichever machine runs them.
 
 mod batch;
 mod chain;
