@@ -42,6 +42,15 @@ def features_rows(rows):
             f"| features of one 12 x 200 window, RMS MAV VAR IAV WL DASDV (LibEMG: {how}) | "
             f"{f'{p:.2f} us CPU' if p else 'not measured'} | "
             f"{f'{o:.2f} us CPU (all 8 features)' if o else 'not measured'} | {ratio(p, o)} | >= 50x: {hit} |")
+    portable = pick(rows, "features_window", "handstack-portable")
+    if portable:
+        q = portable["us_cpu_per_window"]
+        online = pick(rows, "features_window", "libemg", "online")
+        p = online["us_cpu_per_window"] if online else None
+        out.append(
+            f"| the same, handstack's portable build (SSE2 on x86_64; the rows above run the AVX2 "
+            f"build chosen at run time, the same bits) | LibEMG online as above | {q:.2f} us CPU | "
+            f"{ratio(p, q)} | - |")
     return out
 
 

@@ -2,19 +2,21 @@
 //! [`decoder::dsp::multichannel_features_into`] over the windows that
 //! `decoder/ref/features_libemg_bench.py` times LibEMG's FeatureExtractor on.
 //!
-//! `cargo run --release -p decoder --example features_bench -- WINDOWS.npy [--json]`
+//! `cargo run --release -p decoder --example features_bench -- WINDOWS.npy [--json] [--portable]`
 //!
 //! WINDOWS.npy is float64 `(n_windows, channels, samples)` (LibEMG's layout, channel-major per
 //! window, as ours). Prints the median over rounds of the thread's CPU time per window, one
 //! window per call as online; with `--json` one line
-//! `{"what":"features_window","impl":"handstack","us_cpu_per_window":X,...}`.
+//! `{"what":"features_window","impl":"handstack","us_cpu_per_window":X,...}`. The loops run in
+//! the build for the CPU's widest instruction set ([`Simd::detect`]); `--portable` times the
+//! portable build instead (the same bits).
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use cpu_time::ThreadTime;
-use decoder::dsp::multichannel_features_into;
 use decoder::dsp::npy::read_npy;
+use decoder::dsp::{multichannel_features_with, Simd};
 
 /// Rounds timed; the median is reported.
 const ROUNDS: usize = 15;
@@ -24,8 +26,14 @@ const PASSES: usize = 20;
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let json = args.iter().any(|a| a == "--json");
+    let portable = args.iter().any(|a| a == "--portable");
+    let (simd, name) = if portable {
+        (Simd::portable(), "handstack-portable")
+    } else {
+        (Simd::detect(), "handstack")
+    };
     let Some(path) = args.iter().find(|a| !a.starts_with("--")) else {
-        eprintln!("usage: features_bench WINDOWS.npy [--json]");
+        eprintln!("usage: features_bench WINDOWS.npy [--json] [--portable]");
         std::process::exit(2);
     };
     let a = read_npy(path).unwrap_or_else(|e| {
@@ -43,7 +51,7 @@ fn main() {
             let start = ThreadTime::now();
             for _ in 0..PASSES {
                 for w in a.data.chunks_exact(per_window) {
-                    multichannel_features_into(black_box(w), channels, &mut out);
+                    multichannel_features_with(simd, black_box(w), channels, &mut out);
                     black_box(&out);
                 }
             }
@@ -56,11 +64,11 @@ fn main() {
     let (median, best) = (us(rounds[ROUNDS / 2]), us(rounds[0]));
     if json {
         println!(
-            "{{\"what\":\"features_window\",\"impl\":\"handstack\",\"us_cpu_per_window\":{median:.4},\"us_cpu_best\":{best:.4},\"windows\":{n_windows},\"channels\":{channels},\"samples\":{samples}}}"
+            "{{\"what\":\"features_window\",\"impl\":\"{name}\",\"us_cpu_per_window\":{median:.4},\"us_cpu_best\":{best:.4},\"windows\":{n_windows},\"channels\":{channels},\"samples\":{samples}}}"
         );
     } else {
         println!(
-            "handstack features of one {channels} x {samples} window: median {median:.3} us CPU (best {best:.3}) over {ROUNDS} rounds of {} calls",
+            "{name} features of one {channels} x {samples} window: median {median:.3} us CPU (best {best:.3}) over {ROUNDS} rounds of {} calls",
             PASSES * n_windows
         );
     }

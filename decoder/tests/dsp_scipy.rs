@@ -9,7 +9,8 @@ mod dsp_common;
 
 use decoder::dsp::npy::read_npy;
 use decoder::dsp::{
-    batch_features, batch_filtered, multichannel_features_into, ChainConfig, FeatureSignal, Sos,
+    batch_features, batch_filtered, multichannel_features_into, multichannel_features_with, Chain,
+    ChainConfig, FeatureSignal, Simd, Sos,
 };
 use dsp_common::{data_path, rel_err, run_reference, temp_dir};
 use serde_json::Value;
@@ -248,10 +249,19 @@ fn features_only_path_matches_libemg_definitions() {
     // LibEMG feature k is our feature OURS[k] times SCALE[k].
     const OURS: [usize; 6] = [0, 1, 2, 4, 5, 6];
     let scale = [1.0, 1.0, (nf - 1.0) / nf, 1.0, 1.0, 1.0];
-    let mut feats = vec![0.0; 8 * ch];
+    let (mut feats, mut portable) = (vec![0.0; 8 * ch], vec![0.0; 8 * ch]);
     let mut worst = 0.0f64;
     for (i, w) in windows.chunks_exact(ch * len).enumerate() {
         multichannel_features_into(w, ch, &mut feats);
+        // The build for this CPU's instruction set and the portable one: the same bits.
+        multichannel_features_with(Simd::portable(), w, ch, &mut portable);
+        assert!(
+            feats
+                .iter()
+                .zip(&portable)
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "window {i}: dispatched {feats:?} vs portable {portable:?}"
+        );
         for (k, (&o, s)) in OURS.iter().zip(scale).enumerate() {
             for c in 0..ch {
                 let want = theirs[(i * 6 + k) * ch + c];
@@ -269,4 +279,43 @@ fn features_only_path_matches_libemg_definitions() {
         "features-only path vs LibEMG definitions on {n} windows: worst rel. error {worst:e}"
     );
     let _ = std::fs::remove_dir_all(&out);
+}
+
+/// The chain built for this CPU's instruction set (AVX2 where there is one) and the portable
+/// build, fed the same real 3DC samples (with one NaN and one huge value to reset a channel):
+/// the same filtered values and features bit for bit.
+#[test]
+fn dispatched_and_portable_chains_agree_bit_for_bit_on_a_real_recording() {
+    let a = read_npy(data_path("3dc-armband-p4").join("P4_test_emg.npy")).expect("recording");
+    let ch = a.shape[1];
+    let settings = ChainConfig {
+        channels: ch,
+        ..ChainConfig::default()
+    }
+    .validate()
+    .expect("10-channel chain");
+    let mut chains = [
+        Chain::with_simd(&settings, Simd::detect()),
+        Chain::with_simd(&settings, Simd::portable()),
+    ];
+    let same = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits());
+    let mut windows = 0;
+    for (i, s) in a.data.chunks_exact(ch).take(3000).enumerate() {
+        let mut s = s.to_vec();
+        if i == 700 {
+            s[3] = f64::NAN;
+            s[7] = 1e300;
+        }
+        let ends: Vec<bool> = chains.iter_mut().map(|c| c.push(&s)).collect();
+        let [d, p] = &mut chains;
+        assert!(
+            same(d.last_filtered(), p.last_filtered()),
+            "sample {i}: filtered"
+        );
+        if ends[0] {
+            windows += 1;
+            assert!(same(d.features(), p.features()), "sample {i}: features");
+        }
+    }
+    assert!(windows >= 10, "{windows} windows");
 }

@@ -2,7 +2,9 @@
 
 use super::config::{ChainSettings, FeatureSignal};
 use super::faults::{Faults, MAX_ABS_SAMPLE};
-use super::features::{features_into, FEATURES_PER_CHANNEL};
+use super::features::strided_features_into;
+use super::simd::Simd;
+use super::sos::Sos;
 
 /// Filter state smaller than this is set to exactly 0 (every `FLUSH_EVERY` samples). Without
 /// it a silent channel's IIR state decays into subnormal numbers and stays there in a limit
@@ -52,11 +54,20 @@ pub struct Chain {
     /// filtered output.
     last_filtered: Vec<f64>,
     faults: Faults,
+    /// The build of the filter and feature loops that runs (same bits either way).
+    simd: Simd,
 }
 
 impl Chain {
-    /// A chain in reset state for `settings` (which it shares, not copies).
+    /// A chain in reset state for `settings` (which it shares, not copies), its loops built for
+    /// the instruction set detected at run time ([`Simd::detect`]).
     pub fn new(settings: &ChainSettings) -> Chain {
+        Chain::with_simd(settings, Simd::detect())
+    }
+
+    /// [`Chain::new`] with the build of the inner loops chosen by `simd`; every choice gives
+    /// the same bits ([`Simd::portable`] is the reference the tests compare against).
+    pub fn with_simd(settings: &ChainSettings, simd: Simd) -> Chain {
         let n_channels = settings.n_channels();
         let n_state = n_channels * settings.cascade().len();
         let window_len = settings.window_len();
@@ -76,6 +87,7 @@ impl Chain {
             features: vec![0.0; settings.n_features()],
             last_filtered: vec![0.0; n_channels],
             faults: Faults::new(n_channels, window_len),
+            simd,
         }
     }
 
@@ -129,21 +141,12 @@ impl Chain {
             };
         }
 
-        let work = &mut self.last_filtered[..n];
-        for (s, section) in self.settings.cascade().iter().enumerate() {
-            let [b0, b1, b2] = section.b;
-            let [_, a1, a2] = section.a;
-            let z0 = &mut self.z0[s * n..(s + 1) * n];
-            let z1 = &mut self.z1[s * n..(s + 1) * n];
-            for ((x, z0), z1) in work.iter_mut().zip(z0).zip(z1) {
-                // scipy sosfilt's transposed direct form II, term for term.
-                let xin = *x;
-                let y = b0 * xin + *z0;
-                *z0 = b1 * xin - a1 * y + *z1;
-                *z1 = b2 * xin - a2 * y;
-                *x = y;
-            }
-        }
+        let (work, z0, z1) = (&mut self.last_filtered[..n], &mut self.z0, &mut self.z1);
+        let cascade = self.settings.cascade();
+        self.simd.run(
+            #[inline(always)]
+            || run_cascade(cascade, work, z0, z1),
+        );
         if self.count.is_multiple_of(FLUSH_EVERY) {
             for z in self.z0.iter_mut().chain(self.z1.iter_mut()) {
                 if z.abs() < FLUSH_BELOW {
@@ -190,14 +193,12 @@ impl Chain {
     /// Meaningful once [`Chain::samples_seen`] reaches the window length (the older part of the
     /// window is zeros before). No allocation.
     pub fn features(&mut self) -> &[f64] {
-        let w = self.window_len;
-        for ch in 0..self.n_channels {
-            let start = ch * 2 * w + self.head;
-            features_into(
-                &self.ring[start..start + w],
-                &mut self.features[ch * FEATURES_PER_CHANNEL..(ch + 1) * FEATURES_PER_CHANNEL],
-            );
-        }
+        let (w, head) = (self.window_len, self.head);
+        let (ring, features) = (&self.ring, &mut self.features);
+        self.simd.run(
+            #[inline(always)]
+            || strided_features_into(ring, 2 * w, head, w, features),
+        );
         &self.features
     }
 
@@ -231,5 +232,27 @@ impl Chain {
     /// The settings this chain runs with.
     pub fn settings(&self) -> &ChainSettings {
         &self.settings
+    }
+}
+
+/// One sample of every channel (`work`) through the cascade, in place; `z0`, `z1` are the
+/// delay registers `[section][channel]`. Each channel sees scipy `sosfilt`'s transposed direct
+/// form II, term for term; the loop runs over the channels, which the compiler vectorises
+/// (lanes are channels, so the vector width changes nothing in any channel's arithmetic).
+#[inline(always)]
+fn run_cascade(cascade: &[Sos], work: &mut [f64], z0: &mut [f64], z1: &mut [f64]) {
+    let n = work.len();
+    for (s, section) in cascade.iter().enumerate() {
+        let [b0, b1, b2] = section.b;
+        let [_, a1, a2] = section.a;
+        let z0 = &mut z0[s * n..(s + 1) * n];
+        let z1 = &mut z1[s * n..(s + 1) * n];
+        for ((x, z0), z1) in work.iter_mut().zip(z0).zip(z1) {
+            let xin = *x;
+            let y = b0 * xin + *z0;
+            *z0 = b1 * xin - a1 * y + *z1;
+            *z1 = b2 * xin - a2 * y;
+            *x = y;
+        }
     }
 }

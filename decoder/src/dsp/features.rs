@@ -1,5 +1,10 @@
 //! The 8 amplitude features of the paper's Table 1 over one window of one channel.
 
+use super::feature_passes::{
+    first_pass, first_pass_beside, lane_sum, squared_deviations, FirstPass,
+};
+use super::simd::Simd;
+
 /// Features per channel.
 pub const FEATURES_PER_CHANNEL: usize = 8;
 
@@ -16,19 +21,32 @@ const _: () = assert!(matches!(FEATURE_NAMES[RMS_FEATURE].as_bytes(), b"RMS"));
 /// A window shorter than 2 samples has no defined VAR/DASDV/DAMV: all features are 0 then.
 pub fn window_features(x: &[f64]) -> [f64; FEATURES_PER_CHANNEL] {
     let mut out = [0.0; FEATURES_PER_CHANNEL];
-    features_into(x, &mut out);
+    Simd::detect().run(
+        #[inline(always)]
+        || strided_features_into(x, 0, 0, x.len(), &mut out),
+    );
     out
 }
 
 /// The features of one multi-channel window stored channel-major (`n_channels` runs of
 /// `window.len() / n_channels` samples each) into `out`, 8 per channel in [`FEATURE_NAMES`]
 /// order: the features-only path, the same per-channel computation as
-/// [`super::Chain::features`] (bit for bit). Allocation-free.
+/// [`super::Chain::features`] (bit for bit), with the instruction set detected at run time
+/// (see [`multichannel_features_with`]). Allocation-free.
 ///
 /// # Panics
 /// If `n_channels` is 0, `window.len()` is not a multiple of it, or `out` is not
 /// `8 * n_channels` long.
 pub fn multichannel_features_into(window: &[f64], n_channels: usize, out: &mut [f64]) {
+    multichannel_features_with(Simd::detect(), window, n_channels, out);
+}
+
+/// [`multichannel_features_into`] with the build of the loops chosen by `simd`; every choice
+/// gives the same bits. Allocation-free.
+///
+/// # Panics
+/// As [`multichannel_features_into`].
+pub fn multichannel_features_with(simd: Simd, window: &[f64], n_channels: usize, out: &mut [f64]) {
     assert!(
         n_channels > 0 && window.len().is_multiple_of(n_channels),
         "multichannel_features_into: {} values is not {n_channels} equal channels",
@@ -40,23 +58,10 @@ pub fn multichannel_features_into(window: &[f64], n_channels: usize, out: &mut [
         "multichannel_features_into: output length for {n_channels} channels"
     );
     let len = window.len() / n_channels;
-    for (x, o) in window
-        .chunks_exact(len.max(1))
-        .zip(out.chunks_exact_mut(FEATURES_PER_CHANNEL))
-    {
-        features_into(x, o);
-    }
-    if len == 0 {
-        out.fill(0.0);
-    }
-}
-
-/// Lanes of partial sums: four independent accumulators break the add latency chain and let
-/// the compiler vectorise; the order of additions is fixed, so results are deterministic.
-const LANES: usize = 4;
-
-fn lane_sum(acc: [f64; LANES]) -> f64 {
-    (acc[0] + acc[2]) + (acc[1] + acc[3])
+    simd.run(
+        #[inline(always)]
+        || strided_features_into(window, len, 0, len, out),
+    );
 }
 
 /// Sums over one window: enough to get its 8 features.
@@ -73,28 +78,21 @@ struct Stats {
 }
 
 impl Stats {
-    /// Statistics of the window `x` (at least 2 samples). Allocation-free.
-    ///
-    /// Three short passes (sums of x; of the differences; of squared deviations from the
-    /// mean), each a plain loop over fixed-size chunks that the compiler vectorises; the
-    /// window is in L1, so the extra passes cost less than one tangled loop.
-    fn of(x: &[f64]) -> Stats {
-        let n = x.len();
-        debug_assert!(n > 1);
-        let (sum, sum_abs, sum_sq) = sums(x);
-        let (wl, d_sq) = difference_sums(x);
-        let nf = n as f64;
+    /// The statistics from the first pass and the squared deviations `m2`.
+    #[inline(always)]
+    fn new(nf: f64, first: &FirstPass, m2: f64) -> Stats {
         Stats {
             n: nf,
-            sum_abs,
-            sum_sq,
-            wl,
-            d_sq,
-            m2: squared_deviations(x, sum / nf),
+            sum_abs: lane_sum(first.sum_abs),
+            sum_sq: lane_sum(first.sum_sq),
+            wl: lane_sum(first.wl),
+            d_sq: lane_sum(first.d_sq),
+            m2,
         }
     }
 
     /// The 8 features into `out[..8]`.
+    #[inline(always)]
     fn features_into(&self, out: &mut [f64]) {
         let nf = self.n;
         let var = self.m2 / (nf - 1.0);
@@ -109,71 +107,50 @@ impl Stats {
     }
 }
 
-/// Sums of `x[i]`, `|x[i]|` and `x[i]^2`.
-fn sums(x: &[f64]) -> (f64, f64, f64) {
-    let (mut sum, mut sum_abs, mut sum_sq) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
-    let (chunks, rest) = x.as_chunks::<LANES>();
-    for c in chunks {
-        for l in 0..LANES {
-            sum[l] += c[l];
-            sum_abs[l] += c[l].abs();
-            sum_sq[l] += c[l] * c[l];
-        }
-    }
-    for (l, &v) in rest.iter().enumerate() {
-        sum[l] += v;
-        sum_abs[l] += v.abs();
-        sum_sq[l] += v * v;
-    }
-    (lane_sum(sum), lane_sum(sum_abs), lane_sum(sum_sq))
-}
-
-/// Sums of `|x[i+1] - x[i]|` and `(x[i+1] - x[i])^2`, `i < n - 1`.
-fn difference_sums(x: &[f64]) -> (f64, f64) {
-    let (mut wl, mut d_sq) = ([0.0; LANES], [0.0; LANES]);
-    let n = x.len();
-    let (pc, prest) = x[..n - 1].as_chunks::<LANES>();
-    let (nc, nrest) = x[1..].as_chunks::<LANES>();
-    for (p, q) in pc.iter().zip(nc) {
-        for l in 0..LANES {
-            let d = q[l] - p[l];
-            wl[l] += d.abs();
-            d_sq[l] += d * d;
-        }
-    }
-    for (l, (&p, &q)) in prest.iter().zip(nrest).enumerate() {
-        let d = q - p;
-        wl[l] += d.abs();
-        d_sq[l] += d * d;
-    }
-    (lane_sum(wl), lane_sum(d_sq))
-}
-
-/// Sum of `(x[i] - mean)^2`, the second pass: the rectified signal has a large mean next to
-/// its spread, and the one-pass form would cancel catastrophically.
-fn squared_deviations(x: &[f64], mean: f64) -> f64 {
-    let mut ss = [0.0; LANES];
-    let (chunks, rest) = x.as_chunks::<LANES>();
-    for c in chunks {
-        for l in 0..LANES {
-            let d = c[l] - mean;
-            ss[l] += d * d;
-        }
-    }
-    for (l, &v) in rest.iter().enumerate() {
-        let d = v - mean;
-        ss[l] += d * d;
-    }
-    lane_sum(ss)
-}
-
-/// Features of the window `x` into `out[..8]`. Allocation-free.
-pub(crate) fn features_into(x: &[f64], out: &mut [f64]) {
-    if x.len() < 2 {
-        out[..FEATURES_PER_CHANNEL].fill(0.0);
+/// The features of `out.len() / 8` windows of `len` samples each, window `c` being
+/// `data[c * stride + offset..][..len]`, into `out` (8 per window; all 0 if `len < 2`, where
+/// VAR, DASDV and DAMV are undefined). Allocation-free. Inlined into the caller, so it is
+/// compiled for the caller's instruction set (call it inside [`Simd::run`]).
+///
+/// # Panics
+/// If a window lies outside `data`.
+#[inline(always)]
+pub(crate) fn strided_features_into(
+    data: &[f64],
+    stride: usize,
+    offset: usize,
+    len: usize,
+    out: &mut [f64],
+) {
+    if len < 2 {
+        out.fill(0.0);
         return;
     }
-    Stats::of(x).features_into(out);
+    let window = |c: usize| &data[c * stride + offset..c * stride + offset + len];
+    let nf = len as f64;
+    let mean = |first: &FirstPass| lane_sum(first.sum) / nf;
+    // Window c's first pass runs beside window c - 1's second pass (see `first_pass_beside`).
+    let mut prev: Option<FirstPass> = None;
+    let n_windows = out.len() / FEATURES_PER_CHANNEL;
+    let mut outs = out.chunks_exact_mut(FEATURES_PER_CHANNEL);
+    for c in 0..n_windows {
+        let x = window(c);
+        let first = match prev {
+            None => first_pass(x),
+            Some(p) => {
+                let (first, m2) = first_pass_beside(x, window(c - 1), mean(&p));
+                if let Some(o) = outs.next() {
+                    Stats::new(nf, &p, m2).features_into(o);
+                }
+                first
+            }
+        };
+        prev = Some(first);
+    }
+    if let (Some(p), Some(o)) = (prev, outs.next()) {
+        let m2 = squared_deviations(window(n_windows - 1), mean(&p));
+        Stats::new(nf, &p, m2).features_into(o);
+    }
 }
 
 #[cfg(test)]
@@ -224,5 +201,73 @@ mod tests {
             }
         }
         assert_eq!(window_features(&[3.0]), [0.0; 8]);
+    }
+
+    /// The features as the three-pass 4-lane code before the passes were fused and dispatched
+    /// computed them: the per-lane order that must never change.
+    fn three_pass_reference(x: &[f64]) -> [f64; 8] {
+        let lane_sum = |a: [f64; 4]| (a[0] + a[2]) + (a[1] + a[3]);
+        let nf = x.len() as f64;
+        let (mut s, mut sa, mut sq, mut wl, mut dsq, mut ss) =
+            ([0.0; 4], [0.0; 4], [0.0; 4], [0.0; 4], [0.0; 4], [0.0; 4]);
+        for (i, &v) in x.iter().enumerate() {
+            s[i % 4] += v;
+            sa[i % 4] += v.abs();
+            sq[i % 4] += v * v;
+        }
+        for (i, p) in x.windows(2).enumerate() {
+            let d = p[1] - p[0];
+            wl[i % 4] += d.abs();
+            dsq[i % 4] += d * d;
+        }
+        let mean = lane_sum(s) / nf;
+        for (i, &v) in x.iter().enumerate() {
+            ss[i % 4] += (v - mean) * (v - mean);
+        }
+        let (sa, wl, var) = (lane_sum(sa), lane_sum(wl), lane_sum(ss) / (nf - 1.0));
+        [
+            (lane_sum(sq) / nf).sqrt(),
+            sa / nf,
+            var,
+            var.sqrt(),
+            sa,
+            wl,
+            (lane_sum(dsq) / (nf - 1.0)).sqrt(),
+            wl / (nf - 1.0),
+        ]
+    }
+
+    #[test]
+    fn every_build_gives_the_bits_of_the_three_pass_code() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(15);
+        let lengths = (2..=13).chain([31, 32, 33, 199, 200, 201]);
+        for len in lengths {
+            for ch in [1, 2, 3, 12] {
+                let scale = 10f64.powi(rng.gen_range(-3..6));
+                let w: Vec<f64> = (0..len * ch)
+                    .map(|_| rng.gen_range(-1.0..1.0) * scale)
+                    .collect();
+                let mut outs = [vec![0.0; 8 * ch], vec![0.0; 8 * ch]];
+                for (simd, out) in [Simd::portable(), Simd::detect()]
+                    .into_iter()
+                    .zip(&mut outs)
+                {
+                    multichannel_features_with(simd, &w, ch, out);
+                }
+                for c in 0..ch {
+                    let want = three_pass_reference(&w[c * len..(c + 1) * len]);
+                    for out in &outs {
+                        let got = &out[c * 8..(c + 1) * 8];
+                        assert!(
+                            got.iter()
+                                .zip(want)
+                                .all(|(a, b)| a.to_bits() == b.to_bits()),
+                            "length {len}, {ch} channels, channel {c}: {got:?} vs {want:?}"
+                        );
+                    }
+                }
+            }
+        }
     }
 }

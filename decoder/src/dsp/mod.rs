@@ -53,15 +53,22 @@
 //! large) samples are counted per channel in [`Faults`], reset that channel's filter state and
 //! enter the filter as 0, so a channel recovers as soon as the bad samples leave the window.
 //! [`batch_features`] runs the very same streaming code over a whole recording.
+//!
+//! The filter and feature loops are portable Rust compiled twice: for the baseline target and,
+//! chosen at run time, for AVX2 on x86_64 ([`Simd`]; the `pulp` crate's safe dispatch). Both
+//! builds give the same bits (no reassociation, no fused multiply-add; tested), so the daemon,
+//! training and replay agree whichever machine runs them.
 
 mod batch;
 mod chain;
 mod config;
 mod design;
 mod faults;
+mod feature_passes;
 mod features;
 mod front_end;
 pub mod npy;
+mod simd;
 mod sos;
 
 pub use batch::{batch_features, batch_filtered, try_batch_features, BatchError, FeatureMatrix};
@@ -73,7 +80,9 @@ pub use config::{
 pub use design::{butter_bandpass, dc_highpass, iirnotch};
 pub use faults::{Faults, MAX_ABS_SAMPLE};
 pub use features::{
-    multichannel_features_into, window_features, FEATURES_PER_CHANNEL, FEATURE_NAMES, RMS_FEATURE,
+    multichannel_features_into, multichannel_features_with, window_features, FEATURES_PER_CHANNEL,
+    FEATURE_NAMES, RMS_FEATURE,
 };
 pub use front_end::{default_band_high_hz, FrontEnd, FrontEndChain, NYQUIST_FRACTION};
+pub use simd::Simd;
 pub use sos::Sos;

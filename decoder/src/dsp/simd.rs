@@ -1,0 +1,53 @@
+//! Runtime choice of the instruction set the signal chain's inner loops are compiled for.
+//!
+//! The filters and features are plain portable loops over fixed 4-lane accumulators (features)
+//! or over the channels (filters). A default x86_64 build may only assume SSE2, two f64 lanes
+//! per instruction; [`Simd::detect`] finds AVX2 at run time (through `pulp`, whose safe API
+//! runs a closure inside a function compiled with those features) and the very same source is
+//! then compiled a second time, four lanes wide.
+//!
+//! Both builds give the same bits: every operation is an IEEE-754 add, subtract, multiply,
+//! divide, square root or absolute value, each correctly rounded whatever the vector width;
+//! Rust never reassociates floating-point sums and never contracts `a * b + c` into a fused
+//! multiply-add, so each lane sees the same operations in the same order, and the final lane
+//! reduction is the same scalar code. Tests check it on random and real windows.
+//! On aarch64 NEON is part of the baseline, so the portable build is already the vector one.
+
+/// Which build of the inner loops runs: the portable one, or the one for the widest
+/// instruction set the CPU has (AVX2 on x86_64). The same results bit for bit; the choice is
+/// speed only. `Copy`, a few bytes; detected once and kept.
+#[derive(Debug, Clone, Copy)]
+pub struct Simd {
+    arch: Option<pulp::Arch>,
+}
+
+impl Simd {
+    /// The widest instruction set this CPU has (checked at run time).
+    pub fn detect() -> Simd {
+        Simd {
+            arch: Some(pulp::Arch::new()),
+        }
+    }
+
+    /// The portable build only (the reference the dispatched build is tested against).
+    pub fn portable() -> Simd {
+        Simd { arch: None }
+    }
+
+    /// Runs `f`, compiled for the chosen instruction set. Everything `f` calls that should be
+    /// vectorised must be `#[inline(always)]`, so that it is compiled inside `f`.
+    #[inline(always)]
+    pub(crate) fn run<R>(self, f: impl FnOnce() -> R) -> R {
+        match self.arch {
+            Some(arch) => arch.dispatch(f),
+            None => f(),
+        }
+    }
+}
+
+impl Default for Simd {
+    /// [`Simd::detect`].
+    fn default() -> Simd {
+        Simd::detect()
+    }
+}
