@@ -8,7 +8,7 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use hand_dbc::messages::{CalibrationCue, FingerMode, HandHeartbeat};
+use hand_dbc::messages::{CalibrationCue, EmgSamplesG0, FingerMode, HandHeartbeat};
 use hand_model::patient::{Target, TrackingConfig};
 use handstack_tests::vcan::monitor::now_us;
 use handstack_tests::vcan::procs::{handctl, handsim};
@@ -71,9 +71,12 @@ pub(super) fn calibrate_deploy_arm(env: &VcanEnv) -> PathBuf {
         env,
         &["deploy", &model.display().to_string(), "--socket", &sock],
     );
-    handctl(env, &["arm", "--socket", &sock]);
+    // The patient back on the amplifier (a new handsim: the cued one is gone), then arm, as a
+    // technician arms with the electrodes streaming.
     let t_sine = now_us();
     let mut sine = handsim(env, &dir, "handsim-sine", "sine", 25.0, &[]);
+    wait_for_emg_after(&monitor, t_sine);
+    handctl(env, &["arm", "--socket", &sock]);
     sine.wait_success(Duration::from_secs(90));
     let seen: Vec<Seen> = monitor
         .snapshot()
@@ -95,6 +98,7 @@ pub(super) fn calibrate_deploy_arm(env: &VcanEnv) -> PathBuf {
     );
     let r2 = tracking_r2(&seen);
     println!("closed loop after calibrate, deploy and arm: R² {r2:.3}");
+    print_tracked_modes(&seen);
     assert!(r2 >= 0.8, "tracking R² {r2:.3} < 0.8 after calibrate");
     out
 }
@@ -151,4 +155,49 @@ fn tracking_r2(seen: &[Seen]) -> f64 {
     decoder::eval::tracking_metrics(&target, &tracked)
         .expect("metrics")
         .r2
+}
+
+/// Waits (at most 10 s) for an EMG frame on the bus after `t_us`.
+fn wait_for_emg_after(monitor: &Monitor, t_us: u64) {
+    let begun = std::time::Instant::now();
+    while !monitor
+        .snapshot()
+        .iter()
+        .any(|s| s.time_us >= t_us && s.frame.is_some_and(|f| f.raw_id() == EmgSamplesG0::ID))
+    {
+        assert!(
+            begun.elapsed() < Duration::from_secs(10),
+            "the sine patient's amplifier never started"
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
+
+/// What the tracked finger was told over the tracked part of the sine: the first ACTIVE
+/// setpoint after the scenario's start and the share of ACTIVE ones (a low R² with a late or
+/// interrupted ACTIVE is the daemon's state, not the model).
+fn print_tracked_modes(seen: &[Seen]) {
+    let start = scenario_start_us(seen);
+    let finger = TrackingConfig::default().finger;
+    let mine: Vec<_> = setpoints_of(seen)
+        .into_iter()
+        .filter(|s| s.finger == finger && s.time_us >= start)
+        .collect();
+    let first_active = mine
+        .iter()
+        .find(|s| s.mode == FingerMode::Active)
+        .map(|s| (s.time_us - start) as f64 * 1e-3);
+    let tracked: Vec<_> = mine
+        .iter()
+        .filter(|s| s.time_us >= start + 4_000_000)
+        .collect();
+    let active = tracked
+        .iter()
+        .filter(|s| s.mode == FingerMode::Active)
+        .count();
+    println!(
+        "tracked finger: first ACTIVE {first_active:?} ms after the sine's start; {active} of {} \
+         setpoints ACTIVE after its first 4 s",
+        tracked.len()
+    );
 }
