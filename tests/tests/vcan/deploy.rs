@@ -160,8 +160,16 @@ fn check(seen: &[Seen], from: u64, deployed: u64, rolled: u64, (a, b): (u32, u32
         .iter()
         .filter(|s| s.mode == FingerMode::Active)
         .count();
+    // The other modes seen, so a failure says whether the daemon went SAFE (safe stops) or
+    // lost the finger's controller (DISABLED).
+    let others: Vec<_> = thumb
+        .iter()
+        .filter(|s| s.mode != FingerMode::Active)
+        .map(|s| (s.time_us.saturating_sub(from) / 1000, s.mode))
+        .collect();
     println!(
-        "deploy: {} thumb setpoints, {active} ACTIVE, longest gap {gaps} us",
+        "deploy: {} thumb setpoints, {active} ACTIVE, longest gap {gaps} us; others (ms, mode): \
+         {others:?}",
         thumb.len()
     );
     assert!(
