@@ -27,12 +27,6 @@ pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     for (x, y) in ra.iter().zip(rb) {
         tail += x * y;
     }
-    reduce(&acc, tail)
-}
-
-/// The fixed reduction of [`dot`]'s eight accumulators and its tail.
-#[inline(always)]
-fn reduce(acc: &[f64; 8], tail: f64) -> f64 {
     ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7])) + tail
 }
 
