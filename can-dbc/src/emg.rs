@@ -8,6 +8,16 @@
 //! sees no step to zero), counts what it bridged, and reports a gap longer than the configured
 //! limit (20 ms by default) instead of bridging it: the daemon must treat a window with such a
 //! gap as invalid. Nothing is allocated per frame.
+//!
+//! A gap is a break in the *samples*, told by the counter. A silence on the bus whose frames
+//! then resume with the counter in sequence is a late stream, not a gap: every sample is
+//! there, only delivered late (a sender or a receiver that stalled, a USB adapter delivering
+//! in batches). Within [`COUNTER_TRUST_SAMPLES`] periods the 8-bit counter tells the two apart
+//! unambiguously (a sender that loses samples in real time cannot lose more than it had time
+//! to sample), so such a silence is counted ([`EmgStats::late_resumes`]) and the stream goes
+//! on; a longer silence could hide a whole counter wrap and is a gap whatever the counter
+//! says. Whether late samples are fresh enough to act on is the consumer's call (the daemon
+//! checks the newest sample's age and the silence in progress on its own).
 
 use thiserror::Error;
 
@@ -28,6 +38,11 @@ const REORDER_WINDOW: u8 = 4;
 /// Frames whose counter lies up to this far behind the next expected sample are late
 /// arrivals of samples already emitted (dropped and counted), not a jump forward.
 const LATE_WINDOW: u8 = 64;
+/// A silence shorter than this many sample periods whose frames resume in counter sequence is
+/// a late stream, not a gap: a real-time sender loses at most one sample per period, so a
+/// loss in that time moves the counter by less than half its range, far from the
+/// [`LATE_WINDOW`] that a wrap would alias into. Longer silences break the stream.
+pub const COUNTER_TRUST_SAMPLES: u64 = 128;
 
 /// One decoded EMG frame: the group (0..3), the sample counter and its 4 raw channels.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -173,8 +188,9 @@ pub enum EmgConfigError {
 pub struct EmgConfig {
     /// Nominal sample period (1000 µs at 1 kHz).
     pub sample_period_us: u64,
-    /// Silence or counter jump beyond which the stream is reported as broken rather than
-    /// bridged (20 ms by default).
+    /// Counter jump (as time: samples lost) beyond which the stream is reported as broken
+    /// rather than bridged (20 ms by default); a silence over it breaks the stream too unless
+    /// the frames resume in counter sequence within [`COUNTER_TRUST_SAMPLES`] periods.
     pub max_gap_us: u64,
 }
 
@@ -206,6 +222,9 @@ pub struct EmgStats {
     pub duplicate_frames: u64,
     /// Gaps longer than the limit.
     pub gaps: u64,
+    /// Silences longer than the limit after which the counter went on in sequence (a late
+    /// stream, every sample there), not counted as gaps.
+    pub late_resumes: u64,
 }
 
 #[derive(Debug, Clone, Copy, Default)]
@@ -221,6 +240,7 @@ struct Slot {
 #[derive(Debug, Clone)]
 pub struct EmgAssembler {
     max_gap_us: u64,
+    trust_us: u64,
     max_gap_samples: u8,
     slots: [Slot; REORDER_WINDOW as usize],
     next: Option<u8>,
@@ -251,6 +271,7 @@ impl EmgAssembler {
         }
         Ok(Self {
             max_gap_us: config.max_gap_us,
+            trust_us: period.saturating_mul(COUNTER_TRUST_SAMPLES),
             // Bounded by LATE_WINDOW - 1 above, so it fits.
             max_gap_samples: (config.max_gap_us / period) as u8,
             slots: [Slot::default(); REORDER_WINDOW as usize],
@@ -281,8 +302,17 @@ impl EmgAssembler {
     /// tick and stamped with the read time would look like 50 ms gaps.
     pub fn push(&mut self, frame: &EmgFrame, received_us: u64, sink: &mut impl FnMut(&EmgSample)) {
         if let Some(last) = self.last_rx_us {
-            if received_us.saturating_sub(last) > self.max_gap_us {
-                self.break_stream(sink);
+            let silence = received_us.saturating_sub(last);
+            if silence > self.max_gap_us {
+                // The counter decides (below) unless the silence could hide a wrap.
+                let in_sequence = self
+                    .next
+                    .is_some_and(|next| frame.counter.wrapping_sub(next) <= self.max_gap_samples);
+                if silence >= self.trust_us || !in_sequence {
+                    self.break_stream(sink);
+                } else {
+                    self.stats.late_resumes += 1;
+                }
             }
         }
         self.last_rx_us = Some(received_us.max(self.last_rx_us.unwrap_or(0)));
@@ -520,7 +550,7 @@ mod tests {
     }
 
     #[test]
-    fn silence_beyond_the_limit_is_a_gap_not_bridged() {
+    fn silence_with_samples_lost_beyond_the_limit_is_a_gap_not_bridged() {
         let mut asm = assembler();
         let mut input = Vec::new();
         for f in frames(0, 1) {
@@ -536,6 +566,64 @@ mod tests {
         assert!(!out[1].is_bridged());
         assert_eq!(asm.stats().gaps, 1);
         assert_eq!(asm.stats().lost_samples, 0);
+    }
+
+    /// Samples `from..to` (counter mod 256), all three frames of sample `c` received at
+    /// `t0 + (c - from) ms`.
+    fn stream(from: u32, to: u32, t0: u64) -> Vec<(EmgFrame, u64)> {
+        (from..to)
+            .flat_map(|c| {
+                let t = t0 + u64::from(c - from) * 1000;
+                frames(c as u8, c as i16).map(|f| (f, t))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_silence_then_the_counter_in_sequence_is_a_late_stream_not_a_gap() {
+        // A stalled sender: samples 0..10 on time, then 60 ms of nothing, then 10..300 in a
+        // burst and on time again (across a counter wrap).
+        for silence_ms in [21, 60, COUNTER_TRUST_SAMPLES - 1] {
+            let mut asm = assembler();
+            let mut input = stream(0, 10, 0);
+            input.extend(stream(10, 300, 9_000 + silence_ms * 1000));
+            let out = run(&mut asm, &input);
+            let counters: Vec<u8> = out.iter().map(|s| s.counter).collect();
+            assert_eq!(counters, (0..300u32).map(|c| c as u8).collect::<Vec<_>>());
+            assert!(
+                out.iter().all(|s| !s.after_gap && !s.is_bridged()),
+                "{silence_ms} ms"
+            );
+            let st = asm.stats();
+            assert_eq!((st.gaps, st.late_resumes, st.lost_samples), (0, 1, 0));
+        }
+    }
+
+    #[test]
+    fn a_silence_the_counter_cannot_vouch_for_is_a_gap() {
+        // Long enough to hide a counter wrap: a gap whatever the counter says.
+        let mut asm = assembler();
+        let mut input = stream(0, 10, 0);
+        input.extend(stream(10, 20, 9_000 + COUNTER_TRUST_SAMPLES * 1000));
+        let out = run(&mut asm, &input);
+        let gap: Vec<usize> = (0..out.len()).filter(|&i| out[i].after_gap).collect();
+        assert_eq!(gap, [10]);
+        assert_eq!((asm.stats().gaps, asm.stats().late_resumes), (1, 0));
+        // A silence within trust whose counter jumps past the limit (samples lost): a gap.
+        let mut asm = assembler();
+        let mut input = stream(0, 10, 0);
+        input.extend(stream(40, 50, 39_000));
+        let out = run(&mut asm, &input);
+        assert!(out[10].after_gap && out[10].counter == 40);
+        assert_eq!((asm.stats().gaps, asm.stats().late_resumes), (1, 0));
+        // Within trust, a few samples lost in the silence: bridged, as without the silence.
+        let mut asm = assembler();
+        let mut input = stream(0, 10, 0);
+        input.extend(stream(15, 25, 40_000));
+        let out = run(&mut asm, &input);
+        assert!(out.iter().all(|s| !s.after_gap));
+        assert_eq!(out.iter().filter(|s| s.is_bridged()).count(), 5);
+        assert_eq!((asm.stats().gaps, asm.stats().late_resumes), (0, 1));
     }
 
     #[test]

@@ -9,7 +9,8 @@
 //!    repeated one (same counter as the last of its group) is dropped;
 //! 2. decode into an [`EmgFrame`];
 //! 3. reassembly by counter ([`EmgAssembler`]): reordering tolerated, short losses bridged, a
-//!    gap over [`EmgFrontConfig::max_gap_us`] reported on the next sample;
+//!    gap over [`EmgFrontConfig::max_gap_us`] (samples lost, or a silence the counter
+//!    cannot vouch for) reported on the next sample;
 //! 4. rail detection (a raw value equal to [`crate::hand::ADC_MIN`] or [`crate::hand::ADC_MAX`]
 //!    is at a rail of the 12-bit ADC, [`crate::hand::at_rail`]) and
 //!    conversion to µV ([`EMG_LSB_UV`]).
@@ -42,7 +43,9 @@ const GROUP_IDS: [u32; EMG_GROUPS] = [EmgSamplesG0::ID, EmgSamplesG1::ID, EmgSam
 pub struct EmgFrontConfig {
     /// Nominal sample period, µs.
     pub sample_period_us: u64,
-    /// Silence or counter jump beyond which the stream is reported broken, µs.
+    /// Counter jump (samples lost, as time) beyond which the stream is reported broken, µs;
+    /// a silence over it too, unless the counter resumes in sequence soon enough to be
+    /// trusted ([`crate::emg::COUNTER_TRUST_SAMPLES`]).
     pub max_gap_us: u64,
     /// Largest counter step (per group) the E2E check accepts as in sequence.
     pub counter_delta: u16,

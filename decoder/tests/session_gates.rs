@@ -160,3 +160,29 @@ fn without_rest_the_contrast_gate_says_it_did_not_run() {
     assert_eq!(r.notes.len(), 1);
     assert!(r.notes[0].contains("no rest trial"));
 }
+
+#[test]
+fn a_trial_broken_into_short_pieces_gives_no_window_and_says_why() {
+    let (samples, meta) = synth(&clean_protocol(), 16);
+    let mut rec = decoder::session::Recording::from_samples(CHANNELS, samples, RATE).unwrap();
+    // Trial 4's EMG stream breaks every 150 samples: no 200-sample window is whole.
+    let range = trial_range(&meta, 4);
+    rec.breaks = (range.start + 150..range.end).step_by(150).collect();
+    let pieces = rec.breaks.len();
+    let s = Session::from_parts("synthetic".into(), meta, rec).unwrap();
+    let r = check_gates(&s, &GateConfig::default()).unwrap();
+    let none: Vec<_> = r
+        .issues
+        .iter()
+        .filter(|i| i.kind == GateKind::NoWindows)
+        .collect();
+    assert_eq!(none.len(), 1, "{r}");
+    assert_eq!(none[0].trial_id, 4);
+    let m = &none[0].message;
+    assert!(
+        m.contains(&format!("{} EMG samples", range.len()))
+            && m.contains(&format!("{pieces} break(s)"))
+            && m.contains("200 ms of unbroken"),
+        "{m}"
+    );
+}

@@ -196,9 +196,7 @@ pub fn check_gates(session: &Session, config: &GateConfig) -> Result<GateReport,
             report.issues.push(GateIssue {
                 trial_id: t.id,
                 kind: GateKind::NoWindows,
-                message: format!(
-                    "{t}: too short to give a single feature window; record it again, longer"
-                ),
+                message: no_windows_message(session, t),
             });
             continue;
         }
@@ -209,6 +207,30 @@ pub fn check_gates(session: &Session, config: &GateConfig) -> Result<GateReport,
     repeat_gate(trials, &strength, &count, config, &mut report);
     report.issues.sort_by_key(|i| i.trial_id);
     Ok(report)
+}
+
+/// Why a trial gave no window: what the recording holds between its start and end.
+fn no_windows_message(session: &Session, t: &super::Trial) -> String {
+    let r = &session.recording;
+    let range = r.range_of(t.start_us, t.end_us);
+    let breaks = r
+        .breaks
+        .iter()
+        .filter(|&&b| b > range.start && b < range.end)
+        .count();
+    let window_ms = session.meta.chain.window_ms;
+    format!(
+        "{t}: too short to give a single feature window ({:.2} s long, {} EMG samples in it, \
+         {breaks} break(s) in the EMG stream; a window needs {window_ms} ms of unbroken \
+         samples{}); record it again, longer",
+        t.end_us.saturating_sub(t.start_us) as f64 * 1e-6,
+        range.len(),
+        if session.meta.onset_skip_ms > 0.0 {
+            format!(" after the {} ms onset skip", session.meta.onset_skip_ms)
+        } else {
+            String::new()
+        }
+    )
 }
 
 /// Per trial, per channel: the mean windowed RMS; and each trial's window count.
