@@ -6,6 +6,7 @@ use std::path::Path;
 use embedded_can::Frame;
 
 use crate::dbc::CanFrame;
+use crate::world::Listens;
 
 /// What can go wrong on a SocketCAN interface.
 #[derive(Debug, thiserror::Error)]
@@ -63,6 +64,38 @@ impl SocketCanBus {
         socket.set_nonblocking(true).map_err(open_err)?;
         Ok(Self { socket })
     }
+
+    /// Opens `iface` as [`SocketCanBus::open`] does, with the kernel's acceptance filter set
+    /// to what the node reads: the kernel delivers nothing else to this socket.
+    pub fn open_listening(iface: &str, listens: Listens) -> Result<Self, SocketBusError> {
+        let bus = Self::open(iface)?;
+        use socketcan::SocketOptions;
+        let set = match listens {
+            Listens::Nothing => bus.socket.set_filter_drop_all(),
+            Listens::To(ids) => {
+                // Standard ids, exactly: the mask covers the 11 id bits and the extended-frame
+                // flag, so an extended frame with the same low bits does not pass.
+                let filters: Vec<(u32, u32)> = ids
+                    .iter()
+                    .map(|&id| (id, libc_can::SFF_MASK | libc_can::EFF_FLAG))
+                    .collect();
+                bus.socket.set_filters(&filters)
+            }
+        };
+        set.map_err(|source| SocketBusError::Open {
+            iface: iface.to_owned(),
+            source,
+        })?;
+        Ok(bus)
+    }
+}
+
+/// The two constants of linux/can.h the filters need.
+mod libc_can {
+    /// Standard frame id bits.
+    pub const SFF_MASK: u32 = 0x7FF;
+    /// Extended frame flag of `can_id`.
+    pub const EFF_FLAG: u32 = 0x8000_0000;
 }
 
 impl embedded_can::nb::Can for SocketCanBus {

@@ -4,7 +4,7 @@
 //! Each node has its own bus handle (an endpoint of a [`crate::bus::MemBus`], or its own
 //! SocketCAN socket), exactly as separate ECUs would, so every frame crosses the bus.
 
-use hand_dbc::messages::FingerStatus;
+use hand_dbc::messages::{CalibrationCue, FingerSetpoint, FingerStatus, HandEstop};
 
 use crate::error::SimError;
 use crate::faults::FaultPlan;
@@ -78,6 +78,53 @@ pub struct WorldConfig {
     pub start_us: u64,
 }
 
+/// The standard CAN ids one node reads: what a real node's acceptance filter would pass.
+/// Everything else it would only drain unread, so a transport that can filter (SocketCAN in
+/// the kernel) need not deliver it: on `vcan0` every frame would otherwise be copied to each
+/// of the world's eight sockets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Listens {
+    /// Nothing (the amplifier, the fault injector, a scripted patient).
+    Nothing,
+    /// These ids only.
+    To(&'static [u32]),
+}
+
+impl Listens {
+    /// Whether a frame with standard id `id` is one the node reads.
+    pub fn accepts(self, id: u32) -> bool {
+        match self {
+            Listens::Nothing => false,
+            Listens::To(ids) => ids.contains(&id),
+        }
+    }
+}
+
+/// What each finger's controller reads: its own FINGER_SETPOINT and HAND_ESTOP.
+const FINGER_LISTENS: [[u32; 2]; N_FINGERS] = {
+    let mut out = [[0; 2]; N_FINGERS];
+    let mut f = 0;
+    while f < N_FINGERS {
+        out[f] = [FingerSetpoint::IDS[f], HandEstop::ID];
+        f += 1;
+    }
+    out
+};
+
+impl PatientMode {
+    /// What the patient reads from the bus: the tracked finger's FINGER_STATUS (closed loop),
+    /// CALIBRATION_CUE (cued), nothing (scripted).
+    pub fn listens(&self) -> Listens {
+        match self {
+            PatientMode::Script(_) => Listens::Nothing,
+            PatientMode::ClosedLoop(u) => {
+                Listens::To(std::slice::from_ref(&FingerStatus::IDS[u.config().finger]))
+            }
+            PatientMode::Cued(_) => Listens::To(&[CalibrationCue::ID]),
+        }
+    }
+}
+
 impl<B: Bus> World<B> {
     /// Builds the world; `open` is called once per node for its own bus handle (patient,
     /// injector, amplifier if selected, then each selected finger in order).
@@ -86,16 +133,29 @@ impl<B: Bus> World<B> {
         patient: PatientMode,
         mut open: impl FnMut() -> Result<B, E>,
     ) -> Result<Self, SimError> {
-        let mut open = || open().map_err(|e| SimError::Transport(e.to_string()));
-        let patient_bus = open()?;
-        let injector = (FaultInjector::new(cfg.faults.clone()), open()?);
+        Self::try_new_listening(cfg, patient, |_| open())
+    }
+
+    /// As [`World::try_new`], `open` being told what the node reads ([`Listens`]), for a
+    /// transport that filters: nodes behave the same, they only never see what they ignore.
+    pub fn try_new_listening<E: std::fmt::Display>(
+        cfg: WorldConfig,
+        patient: PatientMode,
+        mut open: impl FnMut(Listens) -> Result<B, E>,
+    ) -> Result<Self, SimError> {
+        let mut open = |l| open(l).map_err(|e| SimError::Transport(e.to_string()));
+        let patient_bus = open(patient.listens())?;
+        let injector = (
+            FaultInjector::new(cfg.faults.clone()),
+            open(Listens::Nothing)?,
+        );
         let amp = if cfg.nodes.amplifier {
             let mut amp = AmplifierNode::try_new(AmplifierNodeConfig {
                 start_us: cfg.start_us,
                 ..cfg.amplifier
             })?;
             amp.set_faults(cfg.faults.clone());
-            Some((amp, open()?))
+            Some((amp, open(Listens::Nothing)?))
         } else {
             None
         };
@@ -104,7 +164,7 @@ impl<B: Bus> World<B> {
             if cfg.nodes.fingers & (1 << f) != 0 {
                 let mut node = FingerNode::try_new(f, cfg.finger, cfg.start_us)?;
                 node.set_faults(cfg.faults.clone());
-                fingers.push((node, open()?));
+                fingers.push((node, open(Listens::To(&FINGER_LISTENS[f]))?));
             }
         }
         Ok(Self {

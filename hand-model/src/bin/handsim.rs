@@ -209,8 +209,10 @@ fn run() -> Result<(), String> {
     match (&args.iface, args.mem) {
         (Some(iface), false) => {
             let iface = iface.clone();
-            let world = World::try_new(cfg, run.patient, || SocketCanBus::open(&iface))
-                .map_err(|e| e.to_string())?;
+            let world = World::try_new_listening(cfg, run.patient, |l| {
+                SocketCanBus::open_listening(&iface, l)
+            })
+            .map_err(|e| e.to_string())?;
             eprintln!(
                 "handsim: scenario {} on {iface} for {:.1} s (real time)",
                 scenario.name(),
