@@ -160,11 +160,11 @@ impl<B: Bus> World<B> {
             None
         };
         let mut fingers = Vec::new();
-        for f in 0..N_FINGERS {
+        for (f, listens) in FINGER_LISTENS.iter().enumerate() {
             if cfg.nodes.fingers & (1 << f) != 0 {
                 let mut node = FingerNode::try_new(f, cfg.finger, cfg.start_us)?;
                 node.set_faults(cfg.faults.clone());
-                fingers.push((node, open(Listens::To(&FINGER_LISTENS[f]))?));
+                fingers.push((node, open(Listens::To(listens))?));
             }
         }
         Ok(Self {

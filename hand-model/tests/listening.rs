@@ -126,7 +126,7 @@ fn the_cued_patient_behaves_the_same_behind_its_filter() {
     let cues = || {
         let mut protector = E2eProtector::new(CalibrationCue::E2E);
         move |t: u64, ep: &mut MemEndpoint| {
-            if t % 100_000 != 0 {
+            if !t.is_multiple_of(100_000) {
                 return;
             }
             let (phase, kind) = match t {
