@@ -33,7 +33,7 @@ pub(super) fn calibrate_deploy_arm(env: &VcanEnv) -> PathBuf {
     // No model file: handd starts SAFE with `no_model` and waits for a deploy.
     let cfg = TestConfig::write(env, &dir, &dir.join("no-model-yet.hsm"), 100);
     let monitor = Monitor::start(&env.iface);
-    let _handd = cfg.start(env, &dir);
+    let handd = cfg.start(env, &dir);
     std::thread::sleep(Duration::from_millis(500));
     let sock = cfg.socket.display().to_string();
     let protocol = dir.join("short.toml");
@@ -99,6 +99,15 @@ pub(super) fn calibrate_deploy_arm(env: &VcanEnv) -> PathBuf {
     let r2 = tracking_r2(&seen);
     println!("closed loop after calibrate, deploy and arm: R² {r2:.3}");
     print_tracked_modes(&seen);
+    if r2 < 0.8 {
+        // Why the hand was not driven, in handd's words (its state changes with their causes).
+        let log = handd.output();
+        let changes: Vec<&str> = log.lines().filter(|l| l.contains("state change")).collect();
+        println!(
+            "handd's last state changes:\n{}",
+            changes[changes.len().saturating_sub(20)..].join("\n")
+        );
+    }
     assert!(r2 >= 0.8, "tracking R² {r2:.3} < 0.8 after calibrate");
     out
 }
