@@ -301,19 +301,8 @@ impl EmgAssembler {
     /// candump log time), not the time a batch of frames was read: frames read once per 50 ms
     /// tick and stamped with the read time would look like 50 ms gaps.
     pub fn push(&mut self, frame: &EmgFrame, received_us: u64, sink: &mut impl FnMut(&EmgSample)) {
-        if let Some(last) = self.last_rx_us {
-            let silence = received_us.saturating_sub(last);
-            if silence > self.max_gap_us {
-                // The counter decides (below) unless the silence could hide a wrap.
-                let in_sequence = self
-                    .next
-                    .is_some_and(|next| frame.counter.wrapping_sub(next) <= self.max_gap_samples);
-                if silence >= self.trust_us || !in_sequence {
-                    self.break_stream(sink);
-                } else {
-                    self.stats.late_resumes += 1;
-                }
-            }
+        if self.silence_breaks(frame.counter, received_us) {
+            self.break_stream(sink);
         }
         self.last_rx_us = Some(received_us.max(self.last_rx_us.unwrap_or(0)));
         let next = *self.next.get_or_insert(frame.counter);
@@ -362,6 +351,27 @@ impl EmgAssembler {
                 break;
             }
         }
+    }
+
+    /// Whether the silence before a frame with `counter` received at `received_us` breaks the
+    /// stream: over the limit and either too long for the counter to vouch for, or not resumed
+    /// in counter sequence. A silence the counter vouches for is counted as a late resume.
+    fn silence_breaks(&mut self, counter: u8, received_us: u64) -> bool {
+        let Some(last) = self.last_rx_us else {
+            return false;
+        };
+        let silence = received_us.saturating_sub(last);
+        if silence <= self.max_gap_us {
+            return false;
+        }
+        let in_sequence = self
+            .next
+            .is_some_and(|next| counter.wrapping_sub(next) <= self.max_gap_samples);
+        if silence >= self.trust_us || !in_sequence {
+            return true;
+        }
+        self.stats.late_resumes += 1;
+        false
     }
 
     /// Emits every pending sample (bridging what is missing), e.g. at the end of a replay.
