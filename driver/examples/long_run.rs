@@ -7,8 +7,14 @@
 //!
 //! ```text
 //! long_run train DIR            # record a simulated calibration in DIR, train ResDD, save DIR/model.hsm
-//! long_run run MODEL [MINUTES]  # the long run (default 10 minutes); prints a Markdown report
+//! long_run sleeper MINUTES [RT_PRIORITY]  # (started by `run`) the bare sleeper
+//! long_run run MODEL [MINUTES] [RT_PRIORITY]
+//!                               # the long run (default 10 minutes); prints a Markdown report
 //! ```
+//!
+//! With `RT_PRIORITY` (1-99) the loop thread runs under SCHED_FIFO at that priority, as
+//! handd does with `--rt-priority` (the shipped systemd unit passes 50); without it, normal
+//! scheduling.
 
 use std::path::Path;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -20,7 +26,7 @@ use decoder::model::TrainedModel;
 use decoder::session::Session;
 use driver::daemon::Snapshot;
 use driver::demo::{closed_loop, record_calibration, train_on_session, ClosedLoop, DemoOptions};
-use driver::rt::{lock_memory, RtReport};
+use driver::rt::{lock_memory, set_fifo, RtReport};
 use hand_clock::{Clock, SystemClock};
 
 type Error = Box<dyn std::error::Error>;
@@ -38,6 +44,89 @@ struct Sample {
 struct DaemonEnd {
     overflows: u64,
     cpu_ns: u64,
+    bare: BareSleeper,
+}
+
+/// How late a process that does nothing but sleep to the same 20 Hz deadlines (half a period
+/// after the loop's, with the loop's scheduling) woke, over the same run: the machine's own
+/// wake-up lateness, the floor under any loop's deadline misses. A process of its own, so
+/// that its memory is not in the loop's RSS.
+struct BareSleeper {
+    wakeups: u64,
+    /// Wake-ups more than the deadline slack (5 ms) late.
+    over_slack: u64,
+    p99_us: u64,
+    max_us: u64,
+}
+
+/// The deadline slack of the default configuration, µs.
+const SLACK_US: u64 = 5_000;
+
+/// `long_run sleeper MINUTES [RT_PRIORITY]`: sleeps to every 50 ms deadline for `minutes`,
+/// then prints `wakeups over_slack p99_us max_us`.
+fn bare_sleeper(minutes: f64, rt_priority: Option<u8>) {
+    if let Some(p) = rt_priority {
+        set_fifo(p, &mut RtReport::default());
+    }
+    let mut late_us = Vec::with_capacity((minutes * 60.0 * 20.0) as usize + 100);
+    let period = Duration::from_millis(50);
+    let begun = Instant::now();
+    let end = begun + Duration::from_secs_f64(minutes * 60.0);
+    let mut deadline = begun + period / 2;
+    while deadline < end {
+        let now = Instant::now();
+        if deadline > now {
+            std::thread::sleep(deadline - now);
+        }
+        late_us.push(
+            Instant::now()
+                .saturating_duration_since(deadline)
+                .as_micros() as u64,
+        );
+        deadline += period;
+    }
+    late_us.sort_unstable();
+    let n = late_us.len();
+    println!(
+        "{} {} {} {}",
+        n,
+        late_us.iter().filter(|&&l| l > SLACK_US).count(),
+        late_us
+            .get((n * 99).div_ceil(100).saturating_sub(1))
+            .copied()
+            .unwrap_or(0),
+        late_us.last().copied().unwrap_or(0),
+    );
+}
+
+/// Starts the bare sleeper as a child process of this binary.
+fn start_sleeper(minutes: f64, rt_priority: Option<u8>) -> Result<std::process::Child, Error> {
+    let mut cmd = std::process::Command::new(std::env::current_exe()?);
+    cmd.arg("sleeper").arg(minutes.to_string());
+    if let Some(p) = rt_priority {
+        cmd.arg(p.to_string());
+    }
+    Ok(cmd.stdout(std::process::Stdio::piped()).spawn()?)
+}
+
+/// The bare sleeper's figures, once it has finished.
+fn finish_sleeper(child: std::process::Child) -> Result<BareSleeper, Error> {
+    let out = child.wait_with_output()?;
+    let line = String::from_utf8_lossy(&out.stdout);
+    let v: Vec<u64> = line
+        .split_whitespace()
+        .map(str::parse)
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("bare sleeper printed {line:?}: {e}"))?;
+    let [wakeups, over_slack, p99_us, max_us] = v[..] else {
+        return Err(format!("bare sleeper printed {line:?}").into());
+    };
+    Ok(BareSleeper {
+        wakeups,
+        over_slack,
+        p99_us,
+        max_us,
+    })
 }
 
 /// The process's resident set, kB (VmRSS of /proc/self/status).
@@ -67,7 +156,11 @@ fn train_model(dir: &Path) -> Result<(), Error> {
 }
 
 /// Runs the loop for `minutes`; returns the samples and the daemon thread's end state.
-fn run(model: &TrainedModel, minutes: f64) -> Result<(Vec<Sample>, DaemonEnd), Error> {
+fn run(
+    model: &TrainedModel,
+    minutes: f64,
+    rt_priority: Option<u8>,
+) -> Result<(Vec<Sample>, DaemonEnd), Error> {
     let clock = SystemClock::new();
     let ClosedLoop {
         mut world, runner, ..
@@ -80,17 +173,30 @@ fn run(model: &TrainedModel, minutes: f64) -> Result<(Vec<Sample>, DaemonEnd), E
         let mut runner = runner;
         std::thread::Builder::new()
             .name("handd-loop".into())
+            // handd runs its loop on the main thread, whose stack is resident only as far as
+            // it is touched; here the loop has a thread with the stack of handd's other threads
+            // (all of it resident, since memory is locked).
+            .stack_size(driver::control::THREAD_STACK_BYTES)
             .spawn(move || {
+                if let Some(p) = rt_priority {
+                    let mut rt = RtReport::default();
+                    set_fifo(p, &mut rt);
+                    eprintln!(
+                        "loop thread SCHED_FIFO {:?} {:?}",
+                        rt.fifo_priority, rt.warnings
+                    );
+                }
                 runner.run_realtime(&stop, |_| {
                     let t = ThreadTime::now().as_duration().as_nanos() as u64;
                     cpu_ns.store(t, Ordering::Relaxed);
                 });
-                DaemonEnd {
-                    overflows: runner.transport().overflows(),
-                    cpu_ns: ThreadTime::now().as_duration().as_nanos() as u64,
-                }
+                (
+                    runner.transport().overflows(),
+                    ThreadTime::now().as_duration().as_nanos() as u64,
+                )
             })?
     };
+    let sleeper = start_sleeper(minutes, rt_priority)?;
     let read = || *snapshot.lock().unwrap_or_else(|e| e.into_inner());
     let begun = Instant::now();
     let end = Duration::from_secs_f64(minutes * 60.0);
@@ -114,7 +220,13 @@ fn run(model: &TrainedModel, minutes: f64) -> Result<(Vec<Sample>, DaemonEnd), E
         ));
     }
     stop.store(true, Ordering::Relaxed);
-    let end = daemon.join().map_err(|_| "the daemon thread panicked")?;
+    let bare = finish_sleeper(sleeper)?;
+    let (overflows, cpu_ns) = daemon.join().map_err(|_| "the daemon thread panicked")?;
+    let end = DaemonEnd {
+        overflows,
+        cpu_ns,
+        bare,
+    };
     samples.push(Sample {
         t_s: begun.elapsed().as_secs_f64(),
         rss_kb: rss_kb(),
@@ -192,13 +304,15 @@ fn report(samples: &[Sample], end: &DaemonEnd) -> String {
          | latency p50 / p99 / max | {} / {} / {} µs | |\n\
          | compute per tick p50 / p99 / max | {} / {} / {} µs | |\n\
          | tick lateness p50 / p99 / max | {} / {} / {} µs | |\n\
+         | the machine alone: a bare process sleeping to the same 20 Hz deadlines, same scheduling, same run: wake-ups more than 5 ms late / lateness p99 / max | {} of {} / {} / {} µs | |\n\
          | nothing lost at all | {} | yes |\n\n",
         last.t_s, c.ticks, last.snap.state, last.snap.faults, end.overflows, c.samples_lost, c.bad_frames,
         c.e2e_errors, c.estops, c.deadline_misses, first.t_s, mb(first.rss_kb), mb(warm.rss_kb),
         mb(last.rss_kb), mb(hi - lo), hi - lo, last.snap.latency.p50_us,
         last.snap.latency.p99_us, last.snap.latency.max_us, last.snap.compute.p50_us,
         last.snap.compute.p99_us, last.snap.compute.max_us, last.snap.lateness.p50_us,
-        last.snap.lateness.p99_us, last.snap.lateness.max_us,
+        last.snap.lateness.p99_us, last.snap.lateness.max_us, end.bare.over_slack,
+        end.bare.wakeups, end.bare.p99_us, end.bare.max_us,
         if lost == 0 { "yes" } else { "NO" },
     );
     out += &table(samples);
@@ -209,21 +323,33 @@ fn main() -> Result<(), Error> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.iter().map(String::as_str).collect::<Vec<_>>()[..] {
         ["train", dir] => train_model(Path::new(dir)),
-        ["run", model] | ["run", model, _] => {
+        ["run", model] | ["run", model, _] | ["run", model, _, _] => {
             let minutes: f64 = args.get(2).map_or(Ok(10.0), |m| m.parse())?;
             if !(minutes > 0.0 && minutes.is_finite()) {
                 return Err(format!("minutes must be > 0, got {minutes}").into());
             }
+            let rt_priority = match args.get(3) {
+                None => None,
+                Some(p) => match p.parse::<u8>() {
+                    Ok(p @ 1..=99) => Some(p),
+                    _ => return Err(format!("RT_PRIORITY must be 1..=99, got {p}").into()),
+                },
+            };
             let model = TrainedModel::load(model, None)?;
-            // As handd does before its loop: lock memory (no page fault in a tick); normal
-            // scheduling, since handd's SCHED_FIFO is opt-in (--rt-priority).
+            // As handd does before its loop: lock memory (no page fault in a tick); SCHED_FIFO
+            // for the loop thread only if asked (handd's --rt-priority).
             let mut rt = RtReport::default();
             lock_memory(&mut rt);
             eprintln!("memory locked: {} {:?}", rt.memory_locked, rt.warnings);
-            let (samples, end) = run(&model, minutes)?;
+            let (samples, end) = run(&model, minutes, rt_priority)?;
             print!("{}", report(&samples, &end));
             Ok(())
         }
-        _ => Err("usage: long_run train DIR | long_run run MODEL [MINUTES]".into()),
+        ["sleeper", minutes] | ["sleeper", minutes, _] => {
+            let rt_priority = args.get(2).map(|p| p.parse::<u8>()).transpose()?;
+            bare_sleeper(minutes.parse()?, rt_priority);
+            Ok(())
+        }
+        _ => Err("usage: long_run train DIR | long_run run MODEL [MINUTES] [RT_PRIORITY]".into()),
     }
 }

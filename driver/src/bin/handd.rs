@@ -198,6 +198,7 @@ fn run(args: &Args) -> Result<(), String> {
     };
     std::thread::Builder::new()
         .name("handd-control".into())
+        .stack_size(driver::control::THREAD_STACK_BYTES)
         .spawn(move || server.serve(move |req, peer| handler.handle(req, peer)))
         .map_err(|e| format!("control thread: {e}"))?;
 

@@ -20,7 +20,7 @@ pub use access::{group_id, peer_of, AccessPolicy, Peer};
 pub use client::{request, subscribe, Subscription};
 pub use conn::{REPLY_TIMEOUT, REQUEST_DEADLINE};
 pub use error::ControlError;
-pub use server::{ControlServer, MAX_CONNECTIONS};
+pub use server::{ControlServer, MAX_CONNECTIONS, THREAD_STACK_BYTES};
 pub use subscribers::{
     LiveFeed, LiveModel, SharedLiveModel, LIVE_QUEUE, LIVE_SEND_BUFFER, LIVE_WRITE_TIMEOUT,
     MAX_SUBSCRIBERS,

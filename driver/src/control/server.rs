@@ -20,8 +20,11 @@ use crate::protocol::{Reply, Request};
 /// with a reason.
 pub const MAX_CONNECTIONS: usize = 128;
 
-/// Stack of a connection's thread: it holds one request buffer and a JSON reply.
-const CONN_STACK_BYTES: usize = 256 * 1024;
+/// Stack of every control thread: a connection's (which parses the request, runs the handler,
+/// deploy included, and writes the JSON reply), the accept loop's and the live publisher's.
+/// handd locks all its memory, so each thread's whole stack is resident: at Rust's default of
+/// 2 MiB, two service threads alone would hold 4 MiB.
+pub const THREAD_STACK_BYTES: usize = 256 * 1024;
 
 /// How the server answers a request other than `subscribe`.
 pub(super) type Handler = Box<dyn FnMut(Request, Peer) -> Reply + Send>;
@@ -138,6 +141,7 @@ impl ControlServer {
             let hub = Arc::clone(hub);
             let started = std::thread::Builder::new()
                 .name("handd-live".into())
+                .stack_size(THREAD_STACK_BYTES)
                 .spawn(move || hub.publish_forever());
             if let Err(e) = started {
                 tracing::error!(error = %e, "live publisher thread not started");
@@ -194,7 +198,7 @@ fn admit(stream: UnixStream, policy: &AccessPolicy, shared: &Arc<Shared>) {
     let refusal = stream.try_clone().ok();
     let started = std::thread::Builder::new()
         .name("handd-ctl-conn".into())
-        .stack_size(CONN_STACK_BYTES)
+        .stack_size(THREAD_STACK_BYTES)
         .spawn(move || {
             conn::serve_connection(stream, peer, &slot.0);
             drop(slot);
