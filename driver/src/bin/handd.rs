@@ -154,9 +154,6 @@ fn run(args: &Args) -> Result<(), String> {
 
     let mut rt = RtReport::default();
     lock_memory(&mut rt);
-    if let Some(p) = args.rt_priority {
-        set_fifo(p, &mut rt);
-    }
     for w in &rt.warnings {
         tracing::warn!("{w}");
     }
@@ -205,6 +202,16 @@ fn run(args: &Args) -> Result<(), String> {
     let stop = Arc::new(AtomicBool::new(false));
     for sig in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
         signal_hook::flag::register(sig, Arc::clone(&stop)).map_err(|e| format!("signals: {e}"))?;
+    }
+    // SCHED_FIFO for this thread, the loop's, only now: threads inherit the policy, and the
+    // control threads (spawned above, and the connections they spawn) must not compete with
+    // the loop at its priority.
+    if let Some(p) = args.rt_priority {
+        let mut rt = RtReport::default();
+        set_fifo(p, &mut rt);
+        for w in &rt.warnings {
+            tracing::warn!("{w}");
+        }
     }
     let _ = sd_notify::notify(&[sd_notify::NotifyState::Ready]);
     tracing::info!(socket = %config.control.socket.display(), "running");
