@@ -35,6 +35,8 @@ type Error = Box<dyn std::error::Error>;
 #[derive(Clone, Copy)]
 struct Sample {
     t_s: f64,
+    /// Wall time of the sample, µs since the Unix epoch (the bare sleeper's time base).
+    wall_us: u64,
     rss_kb: u64,
     daemon_cpu_ns: u64,
     snap: Snapshot,
@@ -47,56 +49,78 @@ struct DaemonEnd {
     bare: BareSleeper,
 }
 
-/// How late a process that does nothing but sleep to the same 20 Hz deadlines (half a period
-/// after the loop's, with the loop's scheduling) woke, over the same run: the machine's own
-/// wake-up lateness, the floor under any loop's deadline misses. A process of its own, so
-/// that its memory is not in the loop's RSS.
+/// What a process that does nothing but sleep to a 1 ms grid of deadlines (with the loop's
+/// scheduling) saw over the same run: the machine's own stalls, the floor under any loop's
+/// deadline misses. A process of its own, so that its memory is not in the loop's RSS. After a
+/// late wake-up it skips the deadlines already past, so one stall is one late wake-up.
 struct BareSleeper {
     wakeups: u64,
-    /// Wake-ups more than the deadline slack (5 ms) late.
-    over_slack: u64,
     p99_us: u64,
     max_us: u64,
+    /// Wall time (µs since the Unix epoch) and lateness of every wake-up more than
+    /// [`STALL_US`] late: the machine's stalls.
+    stalls: Vec<(u64, u64)>,
 }
 
 /// The deadline slack of the default configuration, µs.
 const SLACK_US: u64 = 5_000;
+/// The bare sleeper's period: fine enough to see every stall longer than the slack.
+const SLEEPER_PERIOD: Duration = Duration::from_millis(1);
+/// A stall that can make a tick start more than the slack late: the sleeper sees it at most
+/// one period short (it may have woken just before it began).
+const STALL_US: u64 = SLACK_US - 1_000;
 
-/// `long_run sleeper MINUTES [RT_PRIORITY]`: sleeps to every 50 ms deadline for `minutes`,
-/// then prints `wakeups over_slack p99_us max_us`.
+/// Wall time, µs since the Unix epoch: the one time base of this process and the sleeper's.
+fn wall_us() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_micros() as u64)
+}
+
+/// `long_run sleeper MINUTES [RT_PRIORITY]`: sleeps to a 1 ms grid for `minutes`, then prints
+/// `wakeups p99_us max_us`, then one `stall WALL_US LATENESS_US` line per stall.
 fn bare_sleeper(minutes: f64, rt_priority: Option<u8>) {
     if let Some(p) = rt_priority {
         set_fifo(p, &mut RtReport::default());
     }
-    let mut late_us = Vec::with_capacity((minutes * 60.0 * 20.0) as usize + 100);
-    let period = Duration::from_millis(50);
+    // Lateness histogram in µs (the last bin holds everything longer).
+    const BINS: usize = 100_001;
+    let mut hist = vec![0u64; BINS];
+    let (mut wakeups, mut max_us) = (0u64, 0u64);
+    let mut stalls = Vec::new();
     let begun = Instant::now();
     let end = begun + Duration::from_secs_f64(minutes * 60.0);
-    let mut deadline = begun + period / 2;
+    let mut deadline = begun + SLEEPER_PERIOD;
     while deadline < end {
         let now = Instant::now();
         if deadline > now {
             std::thread::sleep(deadline - now);
         }
-        late_us.push(
-            Instant::now()
-                .saturating_duration_since(deadline)
-                .as_micros() as u64,
-        );
-        deadline += period;
+        let woke = Instant::now();
+        let late = woke.saturating_duration_since(deadline).as_micros() as u64;
+        hist[(late as usize).min(BINS - 1)] += 1;
+        wakeups += 1;
+        max_us = max_us.max(late);
+        if late > STALL_US {
+            stalls.push((wall_us(), late));
+        }
+        while deadline <= woke {
+            deadline += SLEEPER_PERIOD;
+        }
     }
-    late_us.sort_unstable();
-    let n = late_us.len();
-    println!(
-        "{} {} {} {}",
-        n,
-        late_us.iter().filter(|&&l| l > SLACK_US).count(),
-        late_us
-            .get((n * 99).div_ceil(100).saturating_sub(1))
-            .copied()
-            .unwrap_or(0),
-        late_us.last().copied().unwrap_or(0),
-    );
+    let want = (wakeups * 99).div_ceil(100);
+    let mut seen = 0;
+    let p99_us = hist
+        .iter()
+        .position(|&c| {
+            seen += c;
+            seen >= want
+        })
+        .unwrap_or(0);
+    println!("{wakeups} {p99_us} {max_us}");
+    for (t, late) in stalls {
+        println!("stall {t} {late}");
+    }
 }
 
 /// Starts the bare sleeper as a child process of this binary.
@@ -112,21 +136,53 @@ fn start_sleeper(minutes: f64, rt_priority: Option<u8>) -> Result<std::process::
 /// The bare sleeper's figures, once it has finished.
 fn finish_sleeper(child: std::process::Child) -> Result<BareSleeper, Error> {
     let out = child.wait_with_output()?;
-    let line = String::from_utf8_lossy(&out.stdout);
-    let v: Vec<u64> = line
+    let text = String::from_utf8_lossy(&out.stdout);
+    let bad = || format!("the bare sleeper printed {text:?}");
+    let mut lines = text.lines();
+    let head: Vec<u64> = lines
+        .next()
+        .ok_or_else(bad)?
         .split_whitespace()
         .map(str::parse)
         .collect::<Result<_, _>>()
-        .map_err(|e| format!("bare sleeper printed {line:?}: {e}"))?;
-    let [wakeups, over_slack, p99_us, max_us] = v[..] else {
-        return Err(format!("bare sleeper printed {line:?}").into());
+        .map_err(|_| bad())?;
+    let [wakeups, p99_us, max_us] = head[..] else {
+        return Err(bad().into());
     };
+    let stalls = lines
+        .map(|l| match l.split_whitespace().collect::<Vec<_>>()[..] {
+            ["stall", t, late] => Ok((t.parse()?, late.parse()?)),
+            _ => Err(bad().into()),
+        })
+        .collect::<Result<Vec<(u64, u64)>, Error>>()?;
     Ok(BareSleeper {
         wakeups,
-        over_slack,
         p99_us,
         max_us,
+        stalls,
     })
+}
+
+/// The loop's deadline misses set against the machine's stalls: (one-second samples in which
+/// the loop missed a deadline, how many of them the bare sleeper saw a stall in, the loop's
+/// misses in those).
+fn misses_against_stalls(samples: &[Sample], stalls: &[(u64, u64)]) -> (usize, usize, u64) {
+    let (mut seconds, mut explained, mut explained_misses) = (0, 0, 0);
+    for w in samples.windows(2) {
+        let misses = w[1].snap.counters.deadline_misses - w[0].snap.counters.deadline_misses;
+        if misses == 0 {
+            continue;
+        }
+        seconds += 1;
+        // A tick is judged when it starts, up to a tick after its deadline: the stall that made
+        // it late can lie up to 100 ms before the sample that counted it.
+        let (from, to) = (w[0].wall_us.saturating_sub(100_000), w[1].wall_us);
+        if stalls.iter().any(|&(t, _)| (from..=to).contains(&t)) {
+            explained += 1;
+            explained_misses += misses;
+        }
+    }
+    (seconds, explained, explained_misses)
 }
 
 /// The process's resident set, kB (VmRSS of /proc/self/status).
@@ -208,6 +264,7 @@ fn run(
         if begun.elapsed() >= next_sample {
             samples.push(Sample {
                 t_s: begun.elapsed().as_secs_f64(),
+                wall_us: wall_us(),
                 rss_kb: rss_kb(),
                 daemon_cpu_ns: cpu_ns.load(Ordering::Relaxed),
                 snap: read(),
@@ -229,6 +286,7 @@ fn run(
     };
     samples.push(Sample {
         t_s: begun.elapsed().as_secs_f64(),
+        wall_us: wall_us(),
         rss_kb: rss_kb(),
         daemon_cpu_ns: end.cpu_ns,
         snap: read(),
@@ -290,6 +348,7 @@ fn report(samples: &[Sample], end: &DaemonEnd) -> String {
             (lo.min(s.rss_kb), hi.max(s.rss_kb))
         });
     let c = &last.snap.counters;
+    let (seconds, explained, explained_misses) = misses_against_stalls(samples, &end.bare.stalls);
     let cpu = last.daemon_cpu_ns as f64 / (last.t_s * 1e9) * 100.0;
     let lost = end.overflows + c.samples_lost + c.bad_frames + c.e2e_errors;
     let mut out = format!(
@@ -304,15 +363,17 @@ fn report(samples: &[Sample], end: &DaemonEnd) -> String {
          | latency p50 / p99 / max | {} / {} / {} µs | |\n\
          | compute per tick p50 / p99 / max | {} / {} / {} µs | |\n\
          | tick lateness p50 / p99 / max | {} / {} / {} µs | |\n\
-         | the machine alone: a bare process sleeping to the same 20 Hz deadlines, same scheduling, same run: wake-ups more than 5 ms late / lateness p99 / max | {} of {} / {} / {} µs | |\n\
+         | the machine alone: a bare process sleeping to a 1 ms grid, the loop's scheduling, same run: stalls over 4 ms (wake-ups that late; a stall over 4 ms can hold a tick over the 5 ms slack) / lateness p99 / max | {} in {} wake-ups / {} / {} µs | |\n\
+         | the loop's misses during the machine's stalls: seconds with a miss that hold a stall of the bare process (misses in them) | {} of {} ({} of {}) | |\n\
          | nothing lost at all | {} | yes |\n\n",
         last.t_s, c.ticks, last.snap.state, last.snap.faults, end.overflows, c.samples_lost, c.bad_frames,
         c.e2e_errors, c.estops, c.deadline_misses, first.t_s, mb(first.rss_kb), mb(warm.rss_kb),
         mb(last.rss_kb), mb(hi - lo), hi - lo, last.snap.latency.p50_us,
         last.snap.latency.p99_us, last.snap.latency.max_us, last.snap.compute.p50_us,
         last.snap.compute.p99_us, last.snap.compute.max_us, last.snap.lateness.p50_us,
-        last.snap.lateness.p99_us, last.snap.lateness.max_us, end.bare.over_slack,
-        end.bare.wakeups, end.bare.p99_us, end.bare.max_us,
+        last.snap.lateness.p99_us, last.snap.lateness.max_us, end.bare.stalls.len(),
+        end.bare.wakeups, end.bare.p99_us, end.bare.max_us, explained, seconds, explained_misses,
+        c.deadline_misses,
         if lost == 0 { "yes" } else { "NO" },
     );
     out += &table(samples);
