@@ -195,9 +195,14 @@ impl Chain {
     pub fn features(&mut self) -> &[f64] {
         let (w, head) = (self.window_len, self.head);
         let (ring, features) = (&self.ring, &mut self.features);
+        let signal = if self.rectify {
+            FeatureSignal::Rectified
+        } else {
+            FeatureSignal::Filtered
+        };
         self.simd.run(
             #[inline(always)]
-            || strided_features_into(ring, 2 * w, head, w, features),
+            || strided_features_into(ring, 2 * w, head, w, signal, features),
         );
         &self.features
     }

@@ -8,6 +8,10 @@
 //! several windows (channels) go through each pass side by side, so the add latency of one
 //! accumulator does not bound the loop; every function is inlined into the caller's
 //! [`super::Simd::run`] and so compiled for its instruction set.
+//!
+//! `RECTIFIED` passes are for a rectified window (every value `>= 0`): there `|x| = x`, so the
+//! sum of `|x|` is the plain sum, value for value in the same order (`+0 + -0 = +0`), the same
+//! bits; it is not accumulated a second time.
 
 /// Lanes of partial sums (the width of one AVX register of f64).
 pub(super) const LANES: usize = 4;
@@ -33,10 +37,23 @@ pub(super) struct FirstPass {
 impl FirstPass {
     /// Adds sample `v` to lane `l`.
     #[inline(always)]
-    fn add_sample(&mut self, l: usize, v: f64) {
+    fn add_sample<const RECTIFIED: bool>(&mut self, l: usize, v: f64) {
         self.sum[l] += v;
-        self.sum_abs[l] += v.abs();
+        if !RECTIFIED {
+            self.sum_abs[l] += v.abs();
+        }
         self.sum_sq[l] += v * v;
+    }
+
+    /// The lanes of the sum of `|x|` (of a rectified window: the plain sum, see the module
+    /// docs).
+    #[inline(always)]
+    pub(super) fn sum_abs<const RECTIFIED: bool>(&self) -> [f64; LANES] {
+        if RECTIFIED {
+            self.sum
+        } else {
+            self.sum_abs
+        }
     }
 
     /// Adds the difference `q - p` to lane `l`.
@@ -50,18 +67,18 @@ impl FirstPass {
     /// Adds the 4 samples `p` (lanes 0..4) and the differences `q[l] - p[l]`, where `q` is `p`
     /// one sample later.
     #[inline(always)]
-    fn add_chunk(&mut self, p: &[f64; LANES], q: &[f64; LANES]) {
+    fn add_chunk<const RECTIFIED: bool>(&mut self, p: &[f64; LANES], q: &[f64; LANES]) {
         for l in 0..LANES {
-            self.add_sample(l, p[l]);
+            self.add_sample::<RECTIFIED>(l, p[l]);
             self.add_difference(l, p[l], q[l]);
         }
     }
 
     /// Adds the samples `x[start..]` and the differences from `start` on, lane `i % 4`.
     #[inline(always)]
-    fn add_tail(&mut self, x: &[f64], start: usize) {
+    fn add_tail<const RECTIFIED: bool>(&mut self, x: &[f64], start: usize) {
         for (i, &v) in x.iter().enumerate().skip(start) {
-            self.add_sample(i % LANES, v);
+            self.add_sample::<RECTIFIED>(i % LANES, v);
         }
         for (i, p) in x.windows(2).enumerate().skip(start) {
             self.add_difference(i % LANES, p[0], p[1]);
@@ -78,15 +95,15 @@ fn whole_chunks(n: usize) -> usize {
 /// The first pass over a window (at least 2 samples): sums of the samples and of their
 /// differences.
 #[inline(always)]
-pub(super) fn first_pass(x: &[f64]) -> FirstPass {
+pub(super) fn first_pass<const RECTIFIED: bool>(x: &[f64]) -> FirstPass {
     let full = whole_chunks(x.len());
     let now = &x.as_chunks().0[..full];
     let next = &x[1..].as_chunks().0[..full];
     let mut acc = FirstPass::default();
     for (p, q) in now.iter().zip(next) {
-        acc.add_chunk(p, q);
+        acc.add_chunk::<RECTIFIED>(p, q);
     }
-    acc.add_tail(x, full * LANES);
+    acc.add_tail::<RECTIFIED>(x, full * LANES);
     acc
 }
 
@@ -95,7 +112,11 @@ pub(super) fn first_pass(x: &[f64]) -> FirstPass {
 /// of squared deviations. One loop for both, so the single add chain of the second pass runs
 /// next to the first pass's independent work instead of bounding its own loop.
 #[inline(always)]
-pub(super) fn first_pass_beside(x: &[f64], prev: &[f64], prev_mean: f64) -> (FirstPass, f64) {
+pub(super) fn first_pass_beside<const RECTIFIED: bool>(
+    x: &[f64],
+    prev: &[f64],
+    prev_mean: f64,
+) -> (FirstPass, f64) {
     let full = whole_chunks(x.len());
     let now = &x.as_chunks().0[..full];
     let next = &x[1..].as_chunks().0[..full];
@@ -103,10 +124,10 @@ pub(super) fn first_pass_beside(x: &[f64], prev: &[f64], prev_mean: f64) -> (Fir
     let mut acc = FirstPass::default();
     let mut ss = [0.0; LANES];
     for ((p, q), b) in now.iter().zip(next).zip(before) {
-        acc.add_chunk(p, q);
+        acc.add_chunk::<RECTIFIED>(p, q);
         add_chunk_squared_deviations(&mut ss, b, prev_mean);
     }
-    acc.add_tail(x, full * LANES);
+    acc.add_tail::<RECTIFIED>(x, full * LANES);
     add_squared_deviations(&mut ss, prev, prev_mean, full);
     (acc, lane_sum(ss))
 }

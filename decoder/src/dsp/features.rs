@@ -1,5 +1,6 @@
 //! The 8 amplitude features of the paper's Table 1 over one window of one channel.
 
+use super::config::FeatureSignal;
 use super::feature_passes::{
     first_pass, first_pass_beside, lane_sum, squared_deviations, FirstPass,
 };
@@ -23,7 +24,7 @@ pub fn window_features(x: &[f64]) -> [f64; FEATURES_PER_CHANNEL] {
     let mut out = [0.0; FEATURES_PER_CHANNEL];
     Simd::detect().run(
         #[inline(always)]
-        || strided_features_into(x, 0, 0, x.len(), &mut out),
+        || strided_features_into(x, 0, 0, x.len(), FeatureSignal::Filtered, &mut out),
     );
     out
 }
@@ -60,7 +61,41 @@ pub fn multichannel_features_with(simd: Simd, window: &[f64], n_channels: usize,
     let len = window.len() / n_channels;
     simd.run(
         #[inline(always)]
-        || strided_features_into(window, len, 0, len, out),
+        || strided_features_into(window, len, 0, len, FeatureSignal::Filtered, out),
+    );
+}
+
+/// [`multichannel_features_with`] for a rectified window (every value `>= 0`, as the chain's
+/// default feature signal is): the same bits, one sum fewer per sample (the sum of `|x|` is the
+/// plain sum there). A window with a negative value breaks the promise and gets wrong MAV and
+/// INT (debug builds panic). Allocation-free.
+///
+/// # Panics
+/// As [`multichannel_features_into`].
+pub fn multichannel_rectified_features_with(
+    simd: Simd,
+    window: &[f64],
+    n_channels: usize,
+    out: &mut [f64],
+) {
+    debug_assert!(
+        !window.iter().any(|&v| v < 0.0),
+        "multichannel_rectified_features_with: a negative value in a rectified window"
+    );
+    assert!(
+        n_channels > 0 && window.len().is_multiple_of(n_channels),
+        "multichannel_rectified_features_with: {} values is not {n_channels} equal channels",
+        window.len()
+    );
+    assert_eq!(
+        out.len(),
+        FEATURES_PER_CHANNEL * n_channels,
+        "multichannel_rectified_features_with: output length for {n_channels} channels"
+    );
+    let len = window.len() / n_channels;
+    simd.run(
+        #[inline(always)]
+        || strided_features_into(window, len, 0, len, FeatureSignal::Rectified, out),
     );
 }
 
@@ -78,12 +113,13 @@ struct Stats {
 }
 
 impl Stats {
-    /// The statistics from the first pass and the squared deviations `m2`.
+    /// The statistics from the first pass (`RECTIFIED` as it ran) and the squared deviations
+    /// `m2`.
     #[inline(always)]
-    fn new(nf: f64, first: &FirstPass, m2: f64) -> Stats {
+    fn new<const RECTIFIED: bool>(nf: f64, first: &FirstPass, m2: f64) -> Stats {
         Stats {
             n: nf,
-            sum_abs: lane_sum(first.sum_abs),
+            sum_abs: lane_sum(first.sum_abs::<RECTIFIED>()),
             sum_sq: lane_sum(first.sum_sq),
             wl: lane_sum(first.wl),
             d_sq: lane_sum(first.d_sq),
@@ -109,13 +145,31 @@ impl Stats {
 
 /// The features of `out.len() / 8` windows of `len` samples each, window `c` being
 /// `data[c * stride + offset..][..len]`, into `out` (8 per window; all 0 if `len < 2`, where
-/// VAR, DASDV and DAMV are undefined). Allocation-free. Inlined into the caller, so it is
-/// compiled for the caller's instruction set (call it inside [`Simd::run`]).
+/// VAR, DASDV and DAMV are undefined). `signal` says what the windows hold: with
+/// [`FeatureSignal::Rectified`] every value must be `>= 0` (the sum of `|x|` is then read from
+/// the plain sum, the same bits). Allocation-free. Inlined into the caller, so it is compiled
+/// for the caller's instruction set (call it inside [`Simd::run`]).
 ///
 /// # Panics
 /// If a window lies outside `data`.
 #[inline(always)]
 pub(crate) fn strided_features_into(
+    data: &[f64],
+    stride: usize,
+    offset: usize,
+    len: usize,
+    signal: FeatureSignal,
+    out: &mut [f64],
+) {
+    match signal {
+        FeatureSignal::Rectified => strided::<true>(data, stride, offset, len, out),
+        FeatureSignal::Filtered => strided::<false>(data, stride, offset, len, out),
+    }
+}
+
+/// [`strided_features_into`] for windows that are rectified or not.
+#[inline(always)]
+fn strided<const RECTIFIED: bool>(
     data: &[f64],
     stride: usize,
     offset: usize,
@@ -136,11 +190,11 @@ pub(crate) fn strided_features_into(
     for c in 0..n_windows {
         let x = window(c);
         let first = match prev {
-            None => first_pass(x),
+            None => first_pass::<RECTIFIED>(x),
             Some(p) => {
-                let (first, m2) = first_pass_beside(x, window(c - 1), mean(&p));
+                let (first, m2) = first_pass_beside::<RECTIFIED>(x, window(c - 1), mean(&p));
                 if let Some(o) = outs.next() {
-                    Stats::new(nf, &p, m2).features_into(o);
+                    Stats::new::<RECTIFIED>(nf, &p, m2).features_into(o);
                 }
                 first
             }
@@ -149,7 +203,7 @@ pub(crate) fn strided_features_into(
     }
     if let (Some(p), Some(o)) = (prev, outs.next()) {
         let m2 = squared_deviations(window(n_windows - 1), mean(&p));
-        Stats::new(nf, &p, m2).features_into(o);
+        Stats::new::<RECTIFIED>(nf, &p, m2).features_into(o);
     }
 }
 
@@ -235,6 +289,37 @@ mod tests {
             (lane_sum(dsq) / (nf - 1.0)).sqrt(),
             wl / (nf - 1.0),
         ]
+    }
+
+    #[test]
+    fn the_rectified_pass_gives_the_bits_of_the_general_one_on_rectified_windows() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(16);
+        for len in (2..=13).chain([31, 32, 33, 199, 200, 201]) {
+            for ch in [1, 2, 3, 12] {
+                let scale = 10f64.powi(rng.gen_range(-3..6));
+                // Rectified values, with exact zeros of both signs among them.
+                let w: Vec<f64> = (0..len * ch)
+                    .map(|i| match i % 7 {
+                        3 => 0.0,
+                        5 => -0.0,
+                        _ => rng.gen_range(0.0..1.0) * scale,
+                    })
+                    .collect();
+                for simd in [Simd::portable(), Simd::detect()] {
+                    let (mut general, mut rectified) = (vec![0.0; 8 * ch], vec![0.0; 8 * ch]);
+                    multichannel_features_with(simd, &w, ch, &mut general);
+                    multichannel_rectified_features_with(simd, &w, ch, &mut rectified);
+                    assert!(
+                        general
+                            .iter()
+                            .zip(&rectified)
+                            .all(|(a, b)| a.to_bits() == b.to_bits()),
+                        "length {len}, {ch} channels, {simd:?}: {general:?} vs {rectified:?}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

@@ -80,8 +80,8 @@ pub use config::{
 pub use design::{butter_bandpass, dc_highpass, iirnotch};
 pub use faults::{Faults, MAX_ABS_SAMPLE};
 pub use features::{
-    multichannel_features_into, multichannel_features_with, window_features, FEATURES_PER_CHANNEL,
-    FEATURE_NAMES, RMS_FEATURE,
+    multichannel_features_into, multichannel_features_with, multichannel_rectified_features_with,
+    window_features, FEATURES_PER_CHANNEL, FEATURE_NAMES, RMS_FEATURE,
 };
 pub use front_end::{default_band_high_hz, FrontEnd, FrontEndChain, NYQUIST_FRACTION};
 pub use simd::Simd;
