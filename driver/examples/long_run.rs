@@ -24,8 +24,9 @@ use std::time::{Duration, Instant};
 use cpu_time::ThreadTime;
 use decoder::model::TrainedModel;
 use decoder::session::Session;
-use driver::daemon::Snapshot;
+use driver::daemon::{Runner, Snapshot};
 use driver::demo::{closed_loop, record_calibration, train_on_session, ClosedLoop, DemoOptions};
+use driver::mem_transport::MemTransport;
 use driver::rt::{lock_memory, set_fifo, RtReport};
 use hand_clock::{Clock, SystemClock};
 
@@ -211,6 +212,41 @@ fn train_model(dir: &Path) -> Result<(), Error> {
     Ok(())
 }
 
+/// The daemon loop on its own thread (SCHED_FIFO at `rt_priority` if given) until `stop`;
+/// it keeps its CPU time in `cpu_ns` after every tick and returns (receive-queue overflows,
+/// CPU time at the end).
+fn spawn_loop(
+    mut runner: Runner<MemTransport<SystemClock>, SystemClock>,
+    stop: Arc<AtomicBool>,
+    cpu_ns: Arc<AtomicU64>,
+    rt_priority: Option<u8>,
+) -> std::io::Result<std::thread::JoinHandle<(u64, u64)>> {
+    std::thread::Builder::new()
+        .name("handd-loop".into())
+        // handd runs its loop on the main thread, whose stack is resident only as far as it is
+        // touched; here the loop has a thread with the stack of handd's other threads (all of
+        // it resident, since memory is locked).
+        .stack_size(driver::control::THREAD_STACK_BYTES)
+        .spawn(move || {
+            if let Some(p) = rt_priority {
+                let mut rt = RtReport::default();
+                set_fifo(p, &mut rt);
+                eprintln!(
+                    "loop thread SCHED_FIFO {:?} {:?}",
+                    rt.fifo_priority, rt.warnings
+                );
+            }
+            runner.run_realtime(&stop, |_| {
+                let t = ThreadTime::now().as_duration().as_nanos() as u64;
+                cpu_ns.store(t, Ordering::Relaxed);
+            });
+            (
+                runner.transport().overflows(),
+                ThreadTime::now().as_duration().as_nanos() as u64,
+            )
+        })
+}
+
 /// Runs the loop for `minutes`; returns the samples and the daemon thread's end state.
 fn run(
     model: &TrainedModel,
@@ -224,34 +260,7 @@ fn run(
     let snapshot = runner.snapshot();
     let stop = Arc::new(AtomicBool::new(false));
     let cpu_ns = Arc::new(AtomicU64::new(0));
-    let daemon = {
-        let (stop, cpu_ns) = (Arc::clone(&stop), Arc::clone(&cpu_ns));
-        let mut runner = runner;
-        std::thread::Builder::new()
-            .name("handd-loop".into())
-            // handd runs its loop on the main thread, whose stack is resident only as far as
-            // it is touched; here the loop has a thread with the stack of handd's other threads
-            // (all of it resident, since memory is locked).
-            .stack_size(driver::control::THREAD_STACK_BYTES)
-            .spawn(move || {
-                if let Some(p) = rt_priority {
-                    let mut rt = RtReport::default();
-                    set_fifo(p, &mut rt);
-                    eprintln!(
-                        "loop thread SCHED_FIFO {:?} {:?}",
-                        rt.fifo_priority, rt.warnings
-                    );
-                }
-                runner.run_realtime(&stop, |_| {
-                    let t = ThreadTime::now().as_duration().as_nanos() as u64;
-                    cpu_ns.store(t, Ordering::Relaxed);
-                });
-                (
-                    runner.transport().overflows(),
-                    ThreadTime::now().as_duration().as_nanos() as u64,
-                )
-            })?
-    };
+    let daemon = spawn_loop(runner, Arc::clone(&stop), Arc::clone(&cpu_ns), rt_priority)?;
     let sleeper = start_sleeper(minutes, rt_priority)?;
     let read = || *snapshot.lock().unwrap_or_else(|e| e.into_inner());
     let begun = Instant::now();

@@ -48,21 +48,7 @@ pub fn multichannel_features_into(window: &[f64], n_channels: usize, out: &mut [
 /// # Panics
 /// As [`multichannel_features_into`].
 pub fn multichannel_features_with(simd: Simd, window: &[f64], n_channels: usize, out: &mut [f64]) {
-    assert!(
-        n_channels > 0 && window.len().is_multiple_of(n_channels),
-        "multichannel_features_into: {} values is not {n_channels} equal channels",
-        window.len()
-    );
-    assert_eq!(
-        out.len(),
-        FEATURES_PER_CHANNEL * n_channels,
-        "multichannel_features_into: output length for {n_channels} channels"
-    );
-    let len = window.len() / n_channels;
-    simd.run(
-        #[inline(always)]
-        || strided_features_into(window, len, 0, len, FeatureSignal::Filtered, out),
-    );
+    multichannel(simd, window, n_channels, FeatureSignal::Filtered, out);
 }
 
 /// [`multichannel_features_with`] for a rectified window (every value `>= 0`, as the chain's
@@ -82,20 +68,31 @@ pub fn multichannel_rectified_features_with(
         !window.iter().any(|&v| v < 0.0),
         "multichannel_rectified_features_with: a negative value in a rectified window"
     );
+    multichannel(simd, window, n_channels, FeatureSignal::Rectified, out);
+}
+
+/// The checks and the dispatch both multichannel entry points share.
+fn multichannel(
+    simd: Simd,
+    window: &[f64],
+    n_channels: usize,
+    signal: FeatureSignal,
+    out: &mut [f64],
+) {
     assert!(
         n_channels > 0 && window.len().is_multiple_of(n_channels),
-        "multichannel_rectified_features_with: {} values is not {n_channels} equal channels",
+        "multichannel features: {} values is not {n_channels} equal channels",
         window.len()
     );
     assert_eq!(
         out.len(),
         FEATURES_PER_CHANNEL * n_channels,
-        "multichannel_rectified_features_with: output length for {n_channels} channels"
+        "multichannel features: output length for {n_channels} channels"
     );
     let len = window.len() / n_channels;
     simd.run(
         #[inline(always)]
-        || strided_features_into(window, len, 0, len, FeatureSignal::Rectified, out),
+        || strided_features_into(window, len, 0, len, signal, out),
     );
 }
 

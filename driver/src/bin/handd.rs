@@ -48,6 +48,16 @@ fn use_colour(json: bool, stderr_is_tty: bool, no_color: Option<&std::ffi::OsStr
     !json && stderr_is_tty && no_color.is_none_or(|v| v.is_empty())
 }
 
+/// SCHED_FIFO at `priority` for the calling thread (the loop's), if asked; a refusal is logged.
+fn loop_priority(priority: Option<u8>) {
+    let Some(p) = priority else { return };
+    let mut rt = RtReport::default();
+    set_fifo(p, &mut rt);
+    for w in &rt.warnings {
+        tracing::warn!("{w}");
+    }
+}
+
 fn init_logs(json: bool) {
     let filter = tracing_subscriber::EnvFilter::try_from_default_env()
         .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
@@ -203,16 +213,9 @@ fn run(args: &Args) -> Result<(), String> {
     for sig in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
         signal_hook::flag::register(sig, Arc::clone(&stop)).map_err(|e| format!("signals: {e}"))?;
     }
-    // SCHED_FIFO for this thread, the loop's, only now: threads inherit the policy, and the
-    // control threads (spawned above, and the connections they spawn) must not compete with
-    // the loop at its priority.
-    if let Some(p) = args.rt_priority {
-        let mut rt = RtReport::default();
-        set_fifo(p, &mut rt);
-        for w in &rt.warnings {
-            tracing::warn!("{w}");
-        }
-    }
+    // Only now: threads inherit the policy, and the control threads (spawned above, and the
+    // connections they spawn) must not compete with the loop at its priority.
+    loop_priority(args.rt_priority);
     let _ = sd_notify::notify(&[sd_notify::NotifyState::Ready]);
     tracing::info!(socket = %config.control.socket.display(), "running");
     let watchdog = sd_notify::watchdog_enabled().map(|d| d / 2);
