@@ -1,7 +1,8 @@
 //! EMG frame decode + reassembly throughput (DESIGN.md section 8 goal: >= 2 million frames/s
 //! on one core; the bus carries 3,000/s).
 //!
-//! `cargo bench -p hand-dbc --bench emg_decode`
+//! `cargo bench -p hand-dbc --bench emg_decode`; `front_end` is the whole front end the daemon
+//! and the offline path share (E2E check, decode, reassembly, rails, µV).
 
 #![allow(
     missing_docs,
@@ -14,6 +15,7 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use hand_dbc::e2e::E2eProtector;
 use hand_dbc::emg::{EmgAssembler, EmgConfig, EmgFrame};
+use hand_dbc::emg_front::{EmgFront, EmgFrontConfig, EmgFrontSettings, FrontSample};
 use hand_dbc::messages::{self, EmgSamplesG0, EmgSamplesG1, EmgSamplesG2};
 use hand_dbc::CanFrame;
 
@@ -75,6 +77,17 @@ fn bench(c: &mut Criterion) {
                 if let Ok(Some(f)) = EmgFrame::decode(frame.raw_id(), frame.data()) {
                     asm.push(&f, *t, &mut |s| acc += i64::from(s.raw[11]));
                 }
+            }
+            black_box(acc)
+        });
+    });
+    group.bench_function("front_end", |b| {
+        let settings = EmgFrontSettings::try_new(EmgFrontConfig::default()).expect("defaults");
+        let mut front = EmgFront::new(&settings);
+        let mut acc = 0.0f64;
+        b.iter(|| {
+            for (frame, t) in &input {
+                front.on_frame(frame, *t, &mut |s: &FrontSample| acc += s.uv()[11]);
             }
             black_box(acc)
         });

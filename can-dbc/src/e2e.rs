@@ -58,6 +58,7 @@ const CRC8_SLICES: [[u8; 256]; SLICE] = {
 
 /// Feeds `data` into a running (not yet finalised) J1850 CRC register, up to 8 bytes at a
 /// time ([`CRC8_SLICES`]).
+#[inline]
 fn crc8_update(mut crc: u8, data: &[u8]) -> u8 {
     for chunk in data.chunks(SLICE) {
         let last = chunk.len() - 1;
@@ -68,6 +69,17 @@ fn crc8_update(mut crc: u8, data: &[u8]) -> u8 {
         crc = next;
     }
     crc
+}
+
+/// [`crc8_update`] over exactly `N` (1..=8) bytes: one slicing step, unrolled. The
+/// protected EMG and command frames are 8 bytes, so a check covers 7.
+#[inline(always)]
+fn crc8_block<const N: usize>(crc: u8, bytes: &[u8; N]) -> u8 {
+    let mut next = CRC8_SLICES[N - 1][usize::from(crc ^ bytes[0])];
+    for (j, &b) in bytes.iter().enumerate().skip(1) {
+        next ^= CRC8_SLICES[N - 1 - j][usize::from(b)];
+    }
+    next
 }
 
 /// CRC-8 SAE J1850 of `data`: poly 0x1D, init 0xFF, xorout 0xFF (check value of "123456789"
@@ -127,6 +139,17 @@ pub struct E2eProfile {
     data_id: u16,
     counter_bits: u8,
     dlc: u8,
+    /// The CRC register after the data id (a function of `data_id`), so a check runs the
+    /// table over the payload only.
+    id_crc: u8,
+}
+
+/// The running J1850 register after the two data id bytes (low byte first), from init 0xFF:
+/// [`crc8_update`]`(0xFF, &data_id.to_le_bytes())`, at compile time.
+const fn crc_after_id(data_id: u16) -> u8 {
+    let [lo, hi] = data_id.to_le_bytes();
+    let after_lo = CRC8_TABLE[(0xFF ^ lo) as usize];
+    CRC8_TABLE[(after_lo ^ hi) as usize]
 }
 
 impl E2eProfile {
@@ -142,6 +165,7 @@ impl E2eProfile {
             data_id,
             counter_bits,
             dlc: dlc as u8,
+            id_crc: crc_after_id(data_id),
         })
     }
 
@@ -151,6 +175,7 @@ impl E2eProfile {
             data_id,
             counter_bits,
             dlc,
+            id_crc: crc_after_id(data_id),
         }
     }
 
@@ -165,15 +190,18 @@ impl E2eProfile {
     }
 
     /// Payload length of the protected message.
+    #[inline]
     pub fn dlc(&self) -> usize {
         usize::from(self.dlc)
     }
 
     /// Number of distinct counter values (16 or 256).
+    #[inline]
     pub fn counter_modulus(&self) -> u16 {
         1 << self.counter_bits
     }
 
+    #[inline]
     fn counter_mask(&self) -> u8 {
         if self.counter_bits == 8 {
             0xFF
@@ -184,14 +212,18 @@ impl E2eProfile {
 
     /// The CRC that `data` (a whole payload, byte 0 included but ignored) should carry.
     /// `data` must hold at least 1 byte; bytes past the first are covered.
+    #[inline]
     pub fn crc(&self, data: &[u8]) -> u8 {
-        let id = self.data_id.to_le_bytes();
-        let crc = crc8_update(0xFF, &id);
         let rest = data.get(1..).unwrap_or(&[]);
-        crc8_update(crc, rest) ^ 0xFF
+        let crc = match <&[u8; 7]>::try_from(rest) {
+            Ok(seven) => crc8_block(self.id_crc, seven),
+            Err(_) => crc8_update(self.id_crc, rest),
+        };
+        crc ^ 0xFF
     }
 
     /// The alive counter carried by `data` (0 if `data` has no counter byte).
+    #[inline]
     pub fn counter(&self, data: &[u8]) -> u8 {
         data.get(1).map_or(0, |b| b & self.counter_mask())
     }
@@ -337,6 +369,7 @@ impl E2eChecker {
     /// receiver's cycle found nothing new. As in AUTOSAR Profile 1, every `None` widens the
     /// allowed counter step of the next frame by one (up to modulus - 1), since the sender
     /// kept counting while nothing arrived.
+    #[inline]
     pub fn check(&mut self, data: Option<&[u8]>) -> E2eStatus {
         let Some(data) = data else {
             self.no_new_data = self.no_new_data.saturating_add(1);
@@ -346,17 +379,17 @@ impl E2eChecker {
             return E2eStatus::Error;
         }
         let counter = self.profile.counter(data);
-        let modulus = self.profile.counter_modulus();
         let Some(last) = self.last_counter else {
             self.last_counter = Some(counter);
             self.no_new_data = 0;
             return E2eStatus::Ok;
         };
-        let delta = (u16::from(counter) + modulus - u16::from(last)) % modulus;
+        // The step modulo 16 or 256: both counters are masked to the width.
+        let delta = u16::from(counter.wrapping_sub(last) & self.profile.counter_mask());
         let allowed = self
             .max_delta
             .saturating_add(self.no_new_data)
-            .min(modulus - 1);
+            .min(self.profile.counter_modulus() - 1);
         if delta == 0 {
             return E2eStatus::Repeated;
         }
@@ -407,8 +440,18 @@ mod tests {
                     bytewise(init, &data[..len]),
                     "len {len}"
                 );
+                if let Ok(seven) = <&[u8; 7]>::try_from(&data[..len]) {
+                    assert_eq!(crc8_block(init, seven), bytewise(init, seven), "block");
+                }
             }
         }
         assert_eq!(crc8_j1850(b"123456789"), 0x4B);
+        for id in [0x0000, 0x1100, 0x12AB, 0xFFFF] {
+            assert_eq!(
+                crc_after_id(id),
+                crc8_update(0xFF, &u16::to_le_bytes(id)),
+                "{id:#x}"
+            );
+        }
     }
 }

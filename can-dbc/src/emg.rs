@@ -88,6 +88,7 @@ impl EmgFrame {
     }
 
     /// Decodes a payload if `id` is one of the EMG ids: `Ok(None)` for any other id.
+    #[inline]
     pub fn decode(id: u32, data: &[u8]) -> Result<Option<Self>, CodecError> {
         Ok(match id {
             EmgSamplesG0::ID => Some(Self::from(&EmgSamplesG0::decode(data)?)),
@@ -99,6 +100,7 @@ impl EmgFrame {
 }
 
 impl From<&EmgSamplesG0> for EmgFrame {
+    #[inline]
     fn from(m: &EmgSamplesG0) -> Self {
         Self {
             group: 0,
@@ -109,6 +111,7 @@ impl From<&EmgSamplesG0> for EmgFrame {
 }
 
 impl From<&EmgSamplesG1> for EmgFrame {
+    #[inline]
     fn from(m: &EmgSamplesG1) -> Self {
         Self {
             group: 1,
@@ -119,6 +122,7 @@ impl From<&EmgSamplesG1> for EmgFrame {
 }
 
 impl From<&EmgSamplesG2> for EmgFrame {
+    #[inline]
     fn from(m: &EmgSamplesG2) -> Self {
         Self {
             group: 2,
@@ -356,6 +360,7 @@ impl EmgAssembler {
     /// Whether the silence before a frame with `counter` received at `received_us` breaks the
     /// stream: over the limit and either too long for the counter to vouch for, or not resumed
     /// in counter sequence. A silence the counter vouches for is counted as a late resume.
+    #[inline]
     fn silence_breaks(&mut self, counter: u8, received_us: u64) -> bool {
         let Some(last) = self.last_rx_us else {
             return false;

@@ -269,6 +269,7 @@ impl EmgFront {
 }
 
 /// One reassembled sample in µV, counted.
+#[inline]
 fn convert(s: &EmgSample, channels: usize, counters: &mut FrontCounters) -> FrontSample {
     let mut uv = [0.0; EMG_CHANNELS];
     let mut railed = 0;

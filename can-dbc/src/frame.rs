@@ -66,6 +66,7 @@ impl CanFrame {
     }
 
     /// The id as a number, without any flag bits (11 or 29 significant bits).
+    #[inline]
     pub fn raw_id(&self) -> u32 {
         match self.id {
             Id::Standard(id) => u32::from(id.as_raw()),
@@ -79,6 +80,7 @@ impl CanFrame {
     }
 
     /// Payload bytes (empty for a remote frame).
+    #[inline]
     pub fn data(&self) -> &[u8] {
         if self.remote {
             &[]
@@ -93,11 +95,13 @@ impl CanFrame {
     }
 
     /// True for an extended (29-bit) id.
+    #[inline]
     pub fn is_extended(&self) -> bool {
         matches!(self.id, Id::Extended(_))
     }
 
     /// True for a remote (RTR) frame.
+    #[inline]
     pub fn is_remote(&self) -> bool {
         self.remote
     }

@@ -35,6 +35,7 @@ pub fn finger_index(name: &str) -> Option<usize> {
 }
 
 /// Whether a raw EMG sample sits on an ADC rail (equal to [`ADC_MIN`] or [`ADC_MAX`]).
+#[inline]
 pub fn at_rail(raw: i16) -> bool {
     raw <= ADC_MIN || raw >= ADC_MAX
 }

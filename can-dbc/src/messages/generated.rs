@@ -785,6 +785,7 @@ impl HandEstop {
     }
 
     /// Decodes a payload; refuses a wrong length, raw values outside the DBC range and values the value tables do not name. The CRC is not checked here: that is [`crate::e2e::E2eChecker`]'s job.
+    #[inline]
     pub fn decode(data: &[u8]) -> Result<Self, CodecError> {
         let message = Self::NAME;
         if data.len() != Self::DLC {
@@ -833,6 +834,7 @@ impl HandEstop {
     }
 
     /// The payload bytes (values were range-checked when set, so this cannot fail).
+    #[inline]
     pub fn encode(&self) -> [u8; 3] {
         let mut bits = 0u64;
         bits |= u64::from(self.crc) & 0xff;
@@ -1305,6 +1307,7 @@ impl EmgSamplesG0 {
     }
 
     /// Decodes a payload; refuses a wrong length, raw values outside the DBC range and values the value tables do not name. The CRC is not checked here: that is [`crate::e2e::E2eChecker`]'s job.
+    #[inline]
     pub fn decode(data: &[u8]) -> Result<Self, CodecError> {
         let message = Self::NAME;
         if data.len() != Self::DLC {
@@ -1334,6 +1337,7 @@ impl EmgSamplesG0 {
     }
 
     /// The payload bytes (values were range-checked when set, so this cannot fail).
+    #[inline]
     pub fn encode(&self) -> [u8; 8] {
         let mut bits = 0u64;
         bits |= u64::from(self.crc) & 0xff;
@@ -1797,6 +1801,7 @@ impl EmgSamplesG1 {
     }
 
     /// Decodes a payload; refuses a wrong length, raw values outside the DBC range and values the value tables do not name. The CRC is not checked here: that is [`crate::e2e::E2eChecker`]'s job.
+    #[inline]
     pub fn decode(data: &[u8]) -> Result<Self, CodecError> {
         let message = Self::NAME;
         if data.len() != Self::DLC {
@@ -1826,6 +1831,7 @@ impl EmgSamplesG1 {
     }
 
     /// The payload bytes (values were range-checked when set, so this cannot fail).
+    #[inline]
     pub fn encode(&self) -> [u8; 8] {
         let mut bits = 0u64;
         bits |= u64::from(self.crc) & 0xff;
@@ -2289,6 +2295,7 @@ impl EmgSamplesG2 {
     }
 
     /// Decodes a payload; refuses a wrong length, raw values outside the DBC range and values the value tables do not name. The CRC is not checked here: that is [`crate::e2e::E2eChecker`]'s job.
+    #[inline]
     pub fn decode(data: &[u8]) -> Result<Self, CodecError> {
         let message = Self::NAME;
         if data.len() != Self::DLC {
@@ -2318,6 +2325,7 @@ impl EmgSamplesG2 {
     }
 
     /// The payload bytes (values were range-checked when set, so this cannot fail).
+    #[inline]
     pub fn encode(&self) -> [u8; 8] {
         let mut bits = 0u64;
         bits |= u64::from(self.crc) & 0xff;
@@ -2636,6 +2644,7 @@ impl EmgStatus {
     }
 
     /// Decodes a payload; refuses a wrong length, raw values outside the DBC range and values the value tables do not name. The CRC is not checked here: that is [`crate::e2e::E2eChecker`]'s job.
+    #[inline]
     pub fn decode(data: &[u8]) -> Result<Self, CodecError> {
         let message = Self::NAME;
         if data.len() != Self::DLC {
@@ -2690,6 +2699,7 @@ impl EmgStatus {
     }
 
     /// The payload bytes (values were range-checked when set, so this cannot fail).
+    #[inline]
     pub fn encode(&self) -> [u8; 7] {
         let mut bits = 0u64;
         bits |= u64::from(self.crc) & 0xff;
@@ -3158,6 +3168,7 @@ impl FingerSetpoint {
     }
 
     /// Decodes a payload; refuses a wrong length, raw values outside the DBC range and values the value tables do not name. The CRC is not checked here: that is [`crate::e2e::E2eChecker`]'s job.
+    #[inline]
     pub fn decode(id: u32, data: &[u8]) -> Result<Self, CodecError> {
         let Some(instance) = Self::instance_of(id) else {
             return Err(CodecError::WrongId {
@@ -3219,6 +3230,7 @@ impl FingerSetpoint {
     }
 
     /// The payload bytes (values were range-checked when set, so this cannot fail).
+    #[inline]
     pub fn encode(&self) -> [u8; 8] {
         let mut bits = 0u64;
         bits |= u64::from(self.crc) & 0xff;
@@ -3720,6 +3732,7 @@ impl FingerStatus {
     }
 
     /// Decodes a payload; refuses a wrong length, raw values outside the DBC range and values the value tables do not name. The CRC is not checked here: that is [`crate::e2e::E2eChecker`]'s job.
+    #[inline]
     pub fn decode(id: u32, data: &[u8]) -> Result<Self, CodecError> {
         let Some(instance) = Self::instance_of(id) else {
             return Err(CodecError::WrongId {
@@ -3792,6 +3805,7 @@ impl FingerStatus {
     }
 
     /// The payload bytes (values were range-checked when set, so this cannot fail).
+    #[inline]
     pub fn encode(&self) -> [u8; 8] {
         let mut bits = 0u64;
         bits |= u64::from(self.crc) & 0xff;
@@ -4067,6 +4081,7 @@ impl HandHeartbeat {
     }
 
     /// Decodes a payload; refuses a wrong length, raw values outside the DBC range and values the value tables do not name. The CRC is not checked here: that is [`crate::e2e::E2eChecker`]'s job.
+    #[inline]
     pub fn decode(data: &[u8]) -> Result<Self, CodecError> {
         let message = Self::NAME;
         if data.len() != Self::DLC {
@@ -4101,6 +4116,7 @@ impl HandHeartbeat {
     }
 
     /// The payload bytes (values were range-checked when set, so this cannot fail).
+    #[inline]
     pub fn encode(&self) -> [u8; 8] {
         let mut bits = 0u64;
         bits |= u64::from(self.crc) & 0xff;
@@ -4696,6 +4712,7 @@ impl HandDiag {
     }
 
     /// Decodes a payload; refuses a wrong length, raw values outside the DBC range and values the value tables do not name. The CRC is not checked here: that is [`crate::e2e::E2eChecker`]'s job.
+    #[inline]
     pub fn decode(data: &[u8]) -> Result<Self, CodecError> {
         let message = Self::NAME;
         if data.len() != Self::DLC {
@@ -4776,6 +4793,7 @@ impl HandDiag {
     }
 
     /// The payload bytes (values were range-checked when set, so this cannot fail).
+    #[inline]
     pub fn encode(&self) -> [u8; 8] {
         let mut bits = 0u64;
         bits |= u64::from(self.tick_latency) & 0xffff;
@@ -5231,6 +5249,7 @@ impl CalibrationCue {
     }
 
     /// Decodes a payload; refuses a wrong length, raw values outside the DBC range and values the value tables do not name. The CRC is not checked here: that is [`crate::e2e::E2eChecker`]'s job.
+    #[inline]
     pub fn decode(data: &[u8]) -> Result<Self, CodecError> {
         let message = Self::NAME;
         if data.len() != Self::DLC {
@@ -5291,6 +5310,7 @@ impl CalibrationCue {
     }
 
     /// The payload bytes (values were range-checked when set, so this cannot fail).
+    #[inline]
     pub fn encode(&self) -> [u8; 8] {
         let mut bits = 0u64;
         bits |= u64::from(self.crc) & 0xff;

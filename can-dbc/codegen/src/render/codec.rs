@@ -12,12 +12,13 @@ pub(super) fn render(g: &Group) -> String {
 /// Checks length, extracts each signal, checks each range and enum value.
 fn decode(g: &Group) -> String {
     let head = if g.is_family() {
-        "pub fn decode(id: u32, data: &[u8]) -> Result<Self, CodecError> {
+        "#[inline]
+pub fn decode(id: u32, data: &[u8]) -> Result<Self, CodecError> {
 let Some(instance) = Self::instance_of(id) else { return Err(CodecError::WrongId { message: Self::NAME, id }); };
 let message = Self::NAMES[instance];
 "
     } else {
-        "pub fn decode(data: &[u8]) -> Result<Self, CodecError> {\nlet message = Self::NAME;\n"
+        "#[inline]\npub fn decode(data: &[u8]) -> Result<Self, CodecError> {\nlet message = Self::NAME;\n"
     };
     let signals = &g.first().signals;
     let fields = join(signals, "", |s| format!("{}, ", s.field));
@@ -76,6 +77,7 @@ fn encode(g: &Group) -> String {
     };
     format!(
         "/// The payload bytes (values were range-checked when set, so this cannot fail).
+#[inline]
 pub fn encode(&self) -> [u8; {dlc}] {{
 let mut bits = 0u64;
 {inserts}{bytes}
