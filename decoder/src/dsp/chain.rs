@@ -1,10 +1,10 @@
 //! The streaming chain: per-channel filter state, the window ring buffer and the features.
 
+use super::cascade::run_cascade;
 use super::config::{ChainSettings, FeatureSignal};
 use super::faults::{Faults, MAX_ABS_SAMPLE};
 use super::features::strided_features_into;
 use super::simd::Simd;
-use super::sos::Sos;
 
 /// Filter state smaller than this is set to exactly 0 (every `FLUSH_EVERY` samples). Without
 /// it a silent channel's IIR state decays into subnormal numbers and stays there in a limit
@@ -122,6 +122,30 @@ impl Chain {
         let n = self.n_channels;
         self.count += 1;
         self.faults.set_now(self.count);
+        let clean = sample.len() == n && sample.iter().all(|v| v.abs() <= MAX_ABS_SAMPLE);
+        if clean {
+            self.last_filtered.copy_from_slice(sample);
+        } else {
+            self.take_bad_sample(sample);
+        }
+
+        let (work, z0, z1) = (&mut self.last_filtered[..n], &mut self.z0, &mut self.z1);
+        let cascade = self.settings.cascade();
+        run_cascade(self.simd, cascade, work, z0, z1);
+        if self.count.is_multiple_of(FLUSH_EVERY) {
+            for z in self.z0.iter_mut().chain(self.z1.iter_mut()) {
+                if z.abs() < FLUSH_BELOW {
+                    *z = 0.0;
+                }
+            }
+        }
+    }
+
+    /// A sample of the wrong length or with a bad value: counted, each bad channel's filter
+    /// state reset and the value filtered as 0 (see [`Chain::push`]).
+    #[cold]
+    fn take_bad_sample(&mut self, sample: &[f64]) {
+        let n = self.n_channels;
         if sample.len() != n {
             self.faults.record_wrong_length();
         }
@@ -139,20 +163,6 @@ impl Chain {
                 self.reset_channel_state(ch);
                 0.0
             };
-        }
-
-        let (work, z0, z1) = (&mut self.last_filtered[..n], &mut self.z0, &mut self.z1);
-        let cascade = self.settings.cascade();
-        self.simd.run(
-            #[inline(always)]
-            || run_cascade(cascade, work, z0, z1),
-        );
-        if self.count.is_multiple_of(FLUSH_EVERY) {
-            for z in self.z0.iter_mut().chain(self.z1.iter_mut()) {
-                if z.abs() < FLUSH_BELOW {
-                    *z = 0.0;
-                }
-            }
         }
     }
 
@@ -237,27 +247,5 @@ impl Chain {
     /// The settings this chain runs with.
     pub fn settings(&self) -> &ChainSettings {
         &self.settings
-    }
-}
-
-/// One sample of every channel (`work`) through the cascade, in place; `z0`, `z1` are the
-/// delay registers `[section][channel]`. Each channel sees scipy `sosfilt`'s transposed direct
-/// form II, term for term; the loop runs over the channels, which the compiler vectorises
-/// (lanes are channels, so the vector width changes nothing in any channel's arithmetic).
-#[inline(always)]
-fn run_cascade(cascade: &[Sos], work: &mut [f64], z0: &mut [f64], z1: &mut [f64]) {
-    let n = work.len();
-    for (s, section) in cascade.iter().enumerate() {
-        let [b0, b1, b2] = section.b;
-        let [_, a1, a2] = section.a;
-        let z0 = &mut z0[s * n..(s + 1) * n];
-        let z1 = &mut z1[s * n..(s + 1) * n];
-        for ((x, z0), z1) in work.iter_mut().zip(z0).zip(z1) {
-            let xin = *x;
-            let y = b0 * xin + *z0;
-            *z0 = b1 * xin - a1 * y + *z1;
-            *z1 = b2 * xin - a2 * y;
-            *x = y;
-        }
     }
 }

@@ -60,6 +60,7 @@
 //! training and replay agree whichever machine runs them.
 
 mod batch;
+mod cascade;
 mod chain;
 mod config;
 mod design;

@@ -19,6 +19,9 @@
 #[derive(Debug, Clone, Copy)]
 pub struct Simd {
     arch: Option<pulp::Arch>,
+    /// AVX2 (with the rest of x86-64-v3), for kernels written with explicit vectors.
+    #[cfg(target_arch = "x86_64")]
+    v3: Option<pulp::x86::V3>,
 }
 
 impl Simd {
@@ -26,12 +29,25 @@ impl Simd {
     pub fn detect() -> Simd {
         Simd {
             arch: Some(pulp::Arch::new()),
+            #[cfg(target_arch = "x86_64")]
+            v3: pulp::x86::V3::try_new(),
         }
     }
 
     /// The portable build only (the reference the dispatched build is tested against).
     pub fn portable() -> Simd {
-        Simd { arch: None }
+        Simd {
+            arch: None,
+            #[cfg(target_arch = "x86_64")]
+            v3: None,
+        }
+    }
+
+    /// The AVX2 token, when this is the dispatched build and the CPU has it: for kernels
+    /// written with explicit four-lane vectors (`V3::vectorize` compiles them for it).
+    #[cfg(target_arch = "x86_64")]
+    pub(crate) fn x86_v3(self) -> Option<pulp::x86::V3> {
+        self.v3
     }
 
     /// Runs `f`, compiled for the chosen instruction set. Everything `f` calls that should be
