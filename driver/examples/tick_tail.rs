@@ -18,7 +18,7 @@ use std::time::Duration;
 use cpu_time::ThreadTime;
 use decoder::dsp::{Chain, ChainConfig, ChainSettings};
 use decoder::model::{
-    AnyModel, ModelKind, ModelSpec, Normalizer, Predictor, TrainedModel, TrainingSummary,
+    AnyModel, ModelKind, ModelSpec, Normalizer, Predictor, Trainable, TrainedModel, TrainingSummary,
 };
 use driver::engine::{Engine, EngineSettings};
 use hand_dbc::emg_front::{EmgFront, EmgFrontConfig, EmgFrontSettings};
@@ -35,10 +35,20 @@ const TICK_US: u64 = 50_000;
 const BIN_NS: u64 = 10;
 const BINS: usize = 20_000;
 
+fn model(chain: &ChainConfig) -> AnyModel {
+    let spec = ModelSpec::default();
+    AnyModel::random(ModelKind::ResDd, &spec, 8 * chain.channels, 5, 1).expect("model")
+}
+
+/// How many f64 weights the model holds.
+fn n_weights(chain: &ChainConfig) -> usize {
+    model(chain).params().len()
+}
+
 fn predictor(chain: &ChainConfig) -> Predictor {
     let n_in = 8 * chain.channels;
     let spec = ModelSpec::default();
-    let model = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, 1).expect("model");
+    let model = model(chain);
     let summary = TrainingSummary::untrained(ModelKind::ResDd);
     let norm = Normalizer::from_scales(vec![100.0; n_in]).expect("scales");
     TrainedModel::new(model, spec, norm, chain.clone(), summary)
@@ -175,6 +185,21 @@ struct Stages {
     filters: f64,
     features: f64,
     model: f64,
+    /// Not a stage: one plain read of as many f64 as the model has weights, per tick (the
+    /// memory floor of the model stage, whose weights do not fit in L1).
+    weights_read: f64,
+}
+
+/// Sum of `w` with eight independent accumulators: a read of every value, nothing else.
+#[inline(never)]
+fn read_all(w: &[f64]) -> f64 {
+    let mut acc = [0.0f64; 8];
+    for c in w.chunks_exact(8) {
+        for k in 0..8 {
+            acc[k] += c[k];
+        }
+    }
+    acc.iter().sum()
 }
 
 /// Median over `rounds` of the mean CPU time per tick of `pass` (one pass = every tick once).
@@ -267,11 +292,20 @@ fn stages(chain_cfg: &ChainConfig, ticks: &[Vec<(u64, CanFrame)>], rounds: usize
         }
         start.elapsed()
     });
+    let weights = vec![1e-3; n_weights(chain_cfg)];
+    let weights_read = per_tick_us(rounds, n, || {
+        let start = ThreadTime::now();
+        for _ in 0..n {
+            black_box(read_all(black_box(&weights)));
+        }
+        start.elapsed()
+    });
     Stages {
         front,
         filters,
         features: both - filters,
         model,
+        weights_read,
     }
 }
 
@@ -298,8 +332,8 @@ fn main() {
     let rest = mean - s.front - s.filters - s.features - s.model;
     if json {
         println!(
-            "{{\"what\":\"daemon_tick\",\"impl\":\"handstack\",\"ticks\":{},\"us_cpu_median\":{p50:.2},\"us_cpu_p99\":{p99:.2},\"us_cpu_max\":{max:.2},\"us_cpu_mean\":{mean:.2},\"timer_ns\":{timer_ns},\"us_front\":{:.2},\"us_filters\":{:.2},\"us_features\":{:.2},\"us_model\":{:.2},\"us_rest\":{rest:.2}}}",
-            hist.n, s.front, s.filters, s.features, s.model
+            "{{\"what\":\"daemon_tick\",\"impl\":\"handstack\",\"ticks\":{},\"us_cpu_median\":{p50:.2},\"us_cpu_p99\":{p99:.2},\"us_cpu_max\":{max:.2},\"us_cpu_mean\":{mean:.2},\"timer_ns\":{timer_ns},\"us_front\":{:.2},\"us_filters\":{:.2},\"us_features\":{:.2},\"us_model\":{:.2},\"us_rest\":{rest:.2},\"us_weights_read\":{:.2},\"weights\":{}}}",
+            hist.n, s.front, s.filters, s.features, s.model, s.weights_read, n_weights(&chain)
         );
         return;
     }
@@ -320,4 +354,9 @@ fn main() {
     ] {
         println!("| {what} | {us:.2} | {:.0} % |", 100.0 * us / mean);
     }
+    println!(
+        "the model's floor: one plain read of its {} f64 weights takes {:.2} us",
+        n_weights(&chain),
+        s.weights_read
+    );
 }
