@@ -15,7 +15,7 @@ use decoder::model::Model as _;
 use driver::config::{Config, DEFAULT_CONFIG_PATH};
 use driver::control::{ControlServer, LiveFeed, LiveModel};
 use driver::daemon::Runner;
-use driver::engine::Engine;
+use driver::engine::{Command, Engine};
 use driver::live::ModelInfo;
 use driver::rt::{lock_memory, set_fifo, RtReport};
 use driver::service::{ControlHandler, COMMAND_QUEUE};
@@ -146,17 +146,7 @@ fn run(args: &Args) -> Result<(), String> {
     let loaded = load_configured(&config, args.check)?;
     tracing::info!(config = %args.config.display(), interface = %config.interface, "config validated");
     if args.check {
-        if let Some(l) = &loaded {
-            println!(
-                "config {} and model {} ({}, id {:08x}) are valid; interface {}\nmodel {}",
-                args.config.display(),
-                config.model.display(),
-                l.model.model().kind(),
-                l.model_id,
-                config.interface,
-                l.status(&config.model).verification
-            );
-        }
+        print_check(args, &config, loaded.as_ref());
         return Ok(());
     }
     // Saves killed midway (a writer's .tmp.PID files) are cleaned up before anything runs.
@@ -172,42 +162,9 @@ fn run(args: &Args) -> Result<(), String> {
     let transport =
         SocketCanTransport::open(&config.interface, clock).map_err(|e| format!("bus: {e}"))?;
     let (engine, chain) = build_engine(&config, loaded.as_ref(), clock.now_us());
-
     let (tx, rx) = mpsc::sync_channel(COMMAND_QUEUE);
     let mut runner = Runner::new(engine, transport, clock, config.tick_ms * 1000).with_commands(rx);
-    let live_model = Arc::new(Mutex::new(LiveModel {
-        info: ModelInfo {
-            id: format!("{:08x}", loaded.as_ref().map_or(0, |l| l.model_id)),
-            path: config.model.display().to_string(),
-            kind: loaded
-                .as_ref()
-                .map_or("none".into(), |l| l.model.model().kind().to_string()),
-        },
-        rest_rms_uv: loaded
-            .as_ref()
-            .and_then(|l| l.model.rest_rms_uv().map(<[f64]>::to_vec)),
-    }));
-    let live = LiveFeed {
-        snapshot: runner.snapshot(),
-        model: Arc::clone(&live_model),
-        tick_us: config.tick_ms * 1000,
-    };
-    let server = ControlServer::bind(&config.control.socket, config.control.group.as_deref())
-        .map_err(|e| e.to_string())?
-        .with_live(live);
-    let mut handler =
-        ControlHandler::new(config.clone(), args.config.clone(), runner.snapshot(), tx)
-            .with_chain(chain)
-            .with_live_model(live_model);
-    handler = match &loaded {
-        Some(l) => handler.with_model(l.status(&config.model)),
-        None => handler.without_model(),
-    };
-    std::thread::Builder::new()
-        .name("handd-control".into())
-        .stack_size(driver::control::THREAD_STACK_BYTES)
-        .spawn(move || server.serve(move |req, peer| handler.handle(req, peer)))
-        .map_err(|e| format!("control thread: {e}"))?;
+    spawn_control(args, &config, loaded.as_ref(), &runner, chain, tx)?;
 
     let stop = Arc::new(AtomicBool::new(false));
     for sig in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
@@ -231,6 +188,67 @@ fn run(args: &Args) -> Result<(), String> {
     });
     let _ = sd_notify::notify(&[sd_notify::NotifyState::Stopping]);
     tracing::info!("stopping");
+    Ok(())
+}
+
+/// `--check`: what would run.
+fn print_check(args: &Args, config: &Config, loaded: Option<&LoadedModel>) {
+    if let Some(l) = loaded {
+        println!(
+            "config {} and model {} ({}, id {:08x}) are valid; interface {}\nmodel {}",
+            args.config.display(),
+            config.model.display(),
+            l.model.model().kind(),
+            l.model_id,
+            config.interface,
+            l.status(&config.model).verification
+        );
+    }
+}
+
+/// The control socket's server on its own thread (`handd-control`): the handler that answers
+/// `handctl` (commands reach the loop through `commands`) and the live feed.
+fn spawn_control(
+    args: &Args,
+    config: &Config,
+    loaded: Option<&LoadedModel>,
+    runner: &Runner<SocketCanTransport<SystemClock>, SystemClock>,
+    chain: ChainConfig,
+    commands: mpsc::SyncSender<Command>,
+) -> Result<(), String> {
+    let live_model = Arc::new(Mutex::new(LiveModel {
+        info: ModelInfo {
+            id: format!("{:08x}", loaded.map_or(0, |l| l.model_id)),
+            path: config.model.display().to_string(),
+            kind: loaded.map_or("none".into(), |l| l.model.model().kind().to_string()),
+        },
+        rest_rms_uv: loaded.and_then(|l| l.model.rest_rms_uv().map(<[f64]>::to_vec)),
+    }));
+    let live = LiveFeed {
+        snapshot: runner.snapshot(),
+        model: Arc::clone(&live_model),
+        tick_us: config.tick_ms * 1000,
+    };
+    let server = ControlServer::bind(&config.control.socket, config.control.group.as_deref())
+        .map_err(|e| e.to_string())?
+        .with_live(live);
+    let handler = ControlHandler::new(
+        config.clone(),
+        args.config.clone(),
+        runner.snapshot(),
+        commands,
+    )
+    .with_chain(chain)
+    .with_live_model(live_model);
+    let mut handler = match loaded {
+        Some(l) => handler.with_model(l.status(&config.model)),
+        None => handler.without_model(),
+    };
+    std::thread::Builder::new()
+        .name("handd-control".into())
+        .stack_size(driver::control::THREAD_STACK_BYTES)
+        .spawn(move || server.serve(move |req, peer| handler.handle(req, peer)))
+        .map_err(|e| format!("control thread: {e}"))?;
     Ok(())
 }
 
