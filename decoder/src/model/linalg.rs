@@ -30,8 +30,8 @@ pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
     ((acc[0] + acc[4]) + (acc[1] + acc[5])) + ((acc[2] + acc[6]) + (acc[3] + acc[7])) + tail
 }
 
-/// Rows of `W x`, one [`dot`] each, compiled inside [`Simd::run`] (AVX2 on x86_64 when
-/// present); every operation is a correctly rounded multiply or add, so the build changes
+/// Rows of `W x`, one [`dot`] each, compiled inside [`Simd::run`] (on x86_64 with AVX2,
+/// [`super::matvec_x86`] runs instead, four rows at a time); every operation is a correctly rounded multiply or add, so the build changes
 /// speed only.
 #[inline(always)]
 fn matvec_rows(w: &[f64], x: &[f64], y: &mut [f64]) {
@@ -57,7 +57,16 @@ pub(crate) fn matvec(w: &[f64], x: &[f64], y: &mut [f64]) {
         y.fill(0.0);
         return;
     }
-    Simd::detect().run(|| matvec_rows(w, x, y));
+    let simd = Simd::detect();
+    #[cfg(target_arch = "x86_64")]
+    if let Some(v3) = simd.x86_v3() {
+        v3.vectorize(
+            #[inline(always)]
+            || super::matvec_x86::matvec(v3, w, x, y),
+        );
+        return;
+    }
+    simd.run(|| matvec_rows(w, x, y));
 }
 
 /// `y = W x + b`.

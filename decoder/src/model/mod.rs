@@ -33,6 +33,8 @@ mod gemm;
 mod init;
 mod kind;
 mod linalg;
+#[cfg(target_arch = "x86_64")]
+mod matvec_x86;
 mod normalizer;
 mod optim;
 mod resdd;
