@@ -25,7 +25,7 @@ const FLUSH_EVERY: u64 = 64;
 /// Nothing here allocates, returns a `Result` or panics after construction.
 ///
 /// Layout: filter state is section-major (`[section][channel]`), so each section runs over all
-/// channels in one loop the compiler vectorises; every channel still sees exactly the
+/// channels at once, lanes being channels (`cascade.rs`); every channel still sees exactly the
 /// operations, in the order, of scipy's `sosfilt`.
 #[derive(Debug, Clone)]
 pub struct Chain {
