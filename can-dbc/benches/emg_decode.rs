@@ -81,6 +81,17 @@ fn bench(c: &mut Criterion) {
             black_box(acc)
         });
     });
+    group.bench_function("decode_only", |b| {
+        let mut acc = 0i64;
+        b.iter(|| {
+            for (frame, _) in &input {
+                if let Ok(Some(f)) = EmgFrame::decode(frame.raw_id(), frame.data()) {
+                    acc += i64::from(f.raw()[1]);
+                }
+            }
+            black_box(acc)
+        });
+    });
     group.bench_function("front_end", |b| {
         let settings = EmgFrontSettings::try_new(EmgFrontConfig::default()).expect("defaults");
         let mut front = EmgFront::new(&settings);
