@@ -168,6 +168,7 @@ pub struct FrontCounters {
 /// One sample as the signal chain takes it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FrontSample {
+    /// Every channel of the bus in µV; the used ones first.
     uv: [f64; EMG_CHANNELS],
     channels: usize,
     /// Receive time of the newest frame that contributed to or released it, µs.
@@ -271,14 +272,10 @@ impl EmgFront {
 /// One reassembled sample in µV, counted.
 #[inline]
 fn convert(s: &EmgSample, channels: usize, counters: &mut FrontCounters) -> FrontSample {
-    let mut uv = [0.0; EMG_CHANNELS];
-    let mut railed = 0;
-    for (out, &raw) in uv.iter_mut().zip(&s.raw).take(channels) {
-        *out = f64::from(raw) * EMG_LSB_UV;
-    }
-    for &raw in &s.raw {
-        railed += u32::from(at_rail(raw));
-    }
+    // Every channel is converted (a fixed-width loop the compiler vectorises);
+    // `FrontSample::uv` hands on the first `channels`.
+    let uv = s.raw.map(|raw| f64::from(raw) * EMG_LSB_UV);
+    let railed = s.raw.iter().map(|&raw| u32::from(at_rail(raw))).sum();
     counters.samples += 1;
     counters.railed += u64::from(railed);
     counters.gaps += u64::from(s.after_gap);
