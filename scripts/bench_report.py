@@ -129,6 +129,13 @@ def tick_section(rows):
                       ("us_model", "model: normalize + ResDD H=96 L=2"),
                       ("us_rest", "the rest: dispatch, faults, conditioning, encode (mean minus the above)")):
         lines.append(f"| {what} | {t[key]:.2f} | {100 * t[key] / mean:.0f} % |")
+    if t["us_rest"] < 0:
+        lines += [
+            "",
+            f"The stages measured alone add up to {mean - t['us_rest']:.2f} us, more than the whole "
+            f"tick's mean of {mean:.2f} us: each runs in its own loop, with its own cache state and "
+            f"loop overhead, so the split shows where the time goes, not an exact budget.",
+        ]
     if "us_weights_read" in t:
         lines += [
             "",
