@@ -188,7 +188,7 @@ def footprint_section(path):
 OTHER_ROWS = """| zero heap allocations in the tick | 0 | **0** allocations, 0 reallocations over 200 ticks of 10 s of simulated traffic | `cargo test -p driver --features sim --test tick_alloc` |
 | ResDD inference alone (normalize + H=96 L=2) | - | 3.4 us CPU (2026-12-01; 4.7 us on 2026-11-22 before the four-row AVX2 product) | `cargo bench -p decoder --bench model -- --warm-up-time 1 --measurement-time 3` |
 | EMG frame decode + reassembly | >= 2 M frames/s | **58-63 M frames/s** (dispatcher path), the whole front end with E2E 44-48 M frames/s (2026-12-01) | `cargo bench -p hand-dbc --bench emg_decode` |
-| band-pass + notch vs scipy `sosfilt`, same sections, 60 s x 12 ch | equal to 1e-9, faster | equal to 1.5e-14; 4.2-5.4 ms vs scipy 6.5-7.5 ms (1.2-1.7x) (2026-11-22) | `cargo test -p decoder --test dsp_scipy -- --nocapture`; `.venv/bin/python decoder/ref/sosfilt_timing.py 20` |
+| band-pass + notch vs scipy `sosfilt`, same sections, 60 s x 12 ch | equal to 1e-9, faster | equal to 1.5e-14; 2.41 ms vs scipy 5.72-7.21 ms (2.4-3.0x) (2026-12-01) | `cargo test -p decoder --test dsp_scipy -- --nocapture`; `.venv/bin/python decoder/ref/sosfilt_timing.py 20` |
 | features equal to LibEMG's definitions (numpy reference; LibEMG's VAR divides by N, ours by N - 1) | 1e-9 relative | 8.9e-16 on 80 windows of the real 3DC recording, centred and rectified | `cargo test -p decoder --test dsp_scipy features_only` |
 | newest sample -> setpoints on the bus | p99 <= 1 ms | on vcan in the qemu VM: p50 2.6-3.8 ms, **p99 5.2-7.9 ms, not reached** there (the emulator's own wake-up delay); on a board not measured | `./scripts/vm/run` (closed-loop line) |"""
 
