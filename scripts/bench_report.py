@@ -161,6 +161,8 @@ def footprint_section(path):
     ticks = re.search(r"run length \| [\d.]+ s, (\d+) ticks", text)
     stalls = re.search(r"the machine alone: .*?\| (\d+) in (\d+) wake-ups / (\d+) / (\d+) µs", text)
     during = re.search(r"the loop's misses during the machine's stalls: .*?\| (\d+) of (\d+) \((\d+) of (\d+)\)", text)
+    # The hand-kept list of earlier runs: the newest one's misses, in bold.
+    earlier = re.search(r"Earlier runs.*?\*\*(\d+) misses?\*\*", text, re.S)
     if not (cpu and rss and miss):
         return ["The footprint: **not measured** (no RELIABILITY.md; run `scripts/bench --long-run`)."]
     cpu_pct = float(cpu.group(1))
@@ -172,16 +174,19 @@ def footprint_section(path):
     if stalls and during:
         machine = (
             f"; the machine alone (a bare process on a 1 ms grid, same run) stalled over 4 ms "
-            f"{stalls.group(1)} times (longest {int(stalls.group(4)) / 1000:.1f} ms), and "
-            f"{during.group(3)} of the {during.group(4)} misses fell in seconds holding such a stall"
+            f"{stalls.group(1)} times (longest {int(stalls.group(4)) / 1000:.1f} ms)"
         )
+        if misses:
+            machine += (f", and {during.group(3)} of the {during.group(4)} misses fell in seconds "
+                        f"holding such a stall")
     return [
         f"| daemon CPU share, 10 min real loop at 20 Hz, simulated world, real clock | <= 1 % of a core | "
         f"**{cpu_pct:.3f} %** ({verdict(cpu_pct <= 1.0)}) | `{cmd}`, {date.group(1) if date else '?'} |",
         f"| RSS, whole process (loop and simulated world) at start / 1 min / end | <= 10 MB | "
         f"**{rss.group(1)} MB** ({verdict(max(rss_mb) <= 10.0)}) | same run |",
         f"| deadline misses at 5 ms slack | 0 | **{misses} of {ticks.group(1) if ticks else '?'}** "
-        f"({verdict(misses == 0)}){machine} (see RELIABILITY.md) | same run |",
+        f"({verdict(misses == 0)}{' in this run' if earlier else ''}){machine}"
+        f"{f'; the run before it missed {earlier.group(1)}' if earlier else ''} (see RELIABILITY.md) | same run |",
     ]
 
 
