@@ -64,7 +64,7 @@ fn portable(cascade: &[Sos], work: &mut [f64], z0: &mut [f64], z1: &mut [f64]) {
 
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use pulp::x86::{f64x4, V3};
+    use pulp::{f64x4, x86::V3};
 
     use super::Sos;
 

@@ -210,10 +210,7 @@ impl Chain {
         } else {
             FeatureSignal::Filtered
         };
-        self.simd.run(
-            #[inline(always)]
-            || strided_features_into(ring, 2 * w, head, w, signal, features),
-        );
+        strided_features_into(self.simd, ring, 2 * w, head, w, signal, features);
         &self.features
     }
 

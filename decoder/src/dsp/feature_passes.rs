@@ -76,7 +76,7 @@ impl FirstPass {
 
     /// Adds the samples `x[start..]` and the differences from `start` on, lane `i % 4`.
     #[inline(always)]
-    fn add_tail<const RECTIFIED: bool>(&mut self, x: &[f64], start: usize) {
+    pub(super) fn add_tail<const RECTIFIED: bool>(&mut self, x: &[f64], start: usize) {
         for (i, &v) in x.iter().enumerate().skip(start) {
             self.add_sample::<RECTIFIED>(i % LANES, v);
         }
@@ -88,7 +88,7 @@ impl FirstPass {
 
 /// Chunks of 4 where both the samples and the differences of an `n`-sample window are whole.
 #[inline(always)]
-fn whole_chunks(n: usize) -> usize {
+pub(super) fn whole_chunks(n: usize) -> usize {
     (n - 1) / LANES
 }
 
@@ -143,7 +143,12 @@ fn add_chunk_squared_deviations(ss: &mut [f64; LANES], c: &[f64; LANES], mean: f
 
 /// Adds `(x[i] - mean)^2` for `i >= 4 * from_chunk` to the lanes `ss`.
 #[inline(always)]
-fn add_squared_deviations(ss: &mut [f64; LANES], x: &[f64], mean: f64, from_chunk: usize) {
+pub(super) fn add_squared_deviations(
+    ss: &mut [f64; LANES],
+    x: &[f64],
+    mean: f64,
+    from_chunk: usize,
+) {
     let (chunks, rest) = x.as_chunks::<LANES>();
     for c in &chunks[from_chunk.min(chunks.len())..] {
         add_chunk_squared_deviations(ss, c, mean);

@@ -22,9 +22,14 @@ const _: () = assert!(matches!(FEATURE_NAMES[RMS_FEATURE].as_bytes(), b"RMS"));
 /// A window shorter than 2 samples has no defined VAR/DASDV/DAMV: all features are 0 then.
 pub fn window_features(x: &[f64]) -> [f64; FEATURES_PER_CHANNEL] {
     let mut out = [0.0; FEATURES_PER_CHANNEL];
-    Simd::detect().run(
-        #[inline(always)]
-        || strided_features_into(x, 0, 0, x.len(), FeatureSignal::Filtered, &mut out),
+    strided_features_into(
+        Simd::detect(),
+        x,
+        0,
+        0,
+        x.len(),
+        FeatureSignal::Filtered,
+        &mut out,
     );
     out
 }
@@ -90,15 +95,12 @@ fn multichannel(
         "multichannel features: output length for {n_channels} channels"
     );
     let len = window.len() / n_channels;
-    simd.run(
-        #[inline(always)]
-        || strided_features_into(window, len, 0, len, signal, out),
-    );
+    strided_features_into(simd, window, len, 0, len, signal, out);
 }
 
 /// Sums over one window: enough to get its 8 features.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-struct Stats {
+pub(super) struct Stats {
     n: f64,
     sum_abs: f64,
     sum_sq: f64,
@@ -113,7 +115,7 @@ impl Stats {
     /// The statistics from the first pass (`RECTIFIED` as it ran) and the squared deviations
     /// `m2`.
     #[inline(always)]
-    fn new<const RECTIFIED: bool>(nf: f64, first: &FirstPass, m2: f64) -> Stats {
+    pub(super) fn new<const RECTIFIED: bool>(nf: f64, first: &FirstPass, m2: f64) -> Stats {
         Stats {
             n: nf,
             sum_abs: lane_sum(first.sum_abs::<RECTIFIED>()),
@@ -126,7 +128,7 @@ impl Stats {
 
     /// The 8 features into `out[..8]`.
     #[inline(always)]
-    fn features_into(&self, out: &mut [f64]) {
+    pub(super) fn features_into(&self, out: &mut [f64]) {
         let nf = self.n;
         let var = self.m2 / (nf - 1.0);
         out[0] = (self.sum_sq / nf).sqrt();
@@ -144,13 +146,14 @@ impl Stats {
 /// `data[c * stride + offset..][..len]`, into `out` (8 per window; all 0 if `len < 2`, where
 /// VAR, DASDV and DAMV are undefined). `signal` says what the windows hold: with
 /// [`FeatureSignal::Rectified`] every value must be `>= 0` (the sum of `|x|` is then read from
-/// the plain sum, the same bits). Allocation-free. Inlined into the caller, so it is compiled
-/// for the caller's instruction set (call it inside [`Simd::run`]).
+/// the plain sum, the same bits). The loops are compiled for the instruction set `simd`
+/// chooses; with AVX-512 two windows go through each pass side by side (`feature_pairs_x86`),
+/// the same bits. Allocation-free.
 ///
 /// # Panics
 /// If a window lies outside `data`.
-#[inline(always)]
 pub(crate) fn strided_features_into(
+    simd: Simd,
     data: &[f64],
     stride: usize,
     offset: usize,
@@ -158,10 +161,19 @@ pub(crate) fn strided_features_into(
     signal: FeatureSignal,
     out: &mut [f64],
 ) {
-    match signal {
-        FeatureSignal::Rectified => strided::<true>(data, stride, offset, len, out),
-        FeatureSignal::Filtered => strided::<false>(data, stride, offset, len, out),
+    #[cfg(target_arch = "x86_64")]
+    if let Some(v4) = simd.x86_v4() {
+        return super::feature_pairs_x86::strided_features_into(
+            v4, data, stride, offset, len, signal, out,
+        );
     }
+    simd.run(
+        #[inline(always)]
+        || match signal {
+            FeatureSignal::Rectified => strided::<true>(data, stride, offset, len, out),
+            FeatureSignal::Filtered => strided::<false>(data, stride, offset, len, out),
+        },
+    )
 }
 
 /// [`strided_features_into`] for windows that are rectified or not.
@@ -293,7 +305,7 @@ mod tests {
         use rand::{Rng, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(16);
         for len in (2..=13).chain([31, 32, 33, 199, 200, 201]) {
-            for ch in [1, 2, 3, 12] {
+            for ch in [1, 2, 3, 4, 5, 12] {
                 let scale = 10f64.powi(rng.gen_range(-3..6));
                 // Rectified values, with exact zeros of both signs among them.
                 let w: Vec<f64> = (0..len * ch)
@@ -303,7 +315,11 @@ mod tests {
                         _ => rng.gen_range(0.0..1.0) * scale,
                     })
                     .collect();
-                for simd in [Simd::portable(), Simd::detect()] {
+                for simd in [
+                    Simd::portable(),
+                    Simd::detect().without_avx512(),
+                    Simd::detect(),
+                ] {
                     let (mut general, mut rectified) = (vec![0.0; 8 * ch], vec![0.0; 8 * ch]);
                     multichannel_features_with(simd, &w, ch, &mut general);
                     multichannel_rectified_features_with(simd, &w, ch, &mut rectified);
@@ -325,15 +341,19 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(15);
         let lengths = (2..=13).chain([31, 32, 33, 199, 200, 201]);
         for len in lengths {
-            for ch in [1, 2, 3, 12] {
+            for ch in [1, 2, 3, 4, 5, 12] {
                 let scale = 10f64.powi(rng.gen_range(-3..6));
                 let w: Vec<f64> = (0..len * ch)
                     .map(|_| rng.gen_range(-1.0..1.0) * scale)
                     .collect();
-                let mut outs = [vec![0.0; 8 * ch], vec![0.0; 8 * ch]];
-                for (simd, out) in [Simd::portable(), Simd::detect()]
-                    .into_iter()
-                    .zip(&mut outs)
+                let mut outs = [vec![0.0; 8 * ch], vec![0.0; 8 * ch], vec![0.0; 8 * ch]];
+                for (simd, out) in [
+                    Simd::portable(),
+                    Simd::detect().without_avx512(),
+                    Simd::detect(),
+                ]
+                .into_iter()
+                .zip(&mut outs)
                 {
                     multichannel_features_with(simd, &w, ch, out);
                 }

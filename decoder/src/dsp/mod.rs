@@ -55,11 +55,12 @@
 //! [`batch_features`] runs the very same streaming code over a whole recording.
 //!
 //! The filter and feature loops are portable Rust compiled twice: for the baseline target and,
-//! chosen at run time, for AVX2 on x86_64 ([`Simd`]; the `pulp` crate's safe dispatch). At 4,
-//! 8, 12 and 16 channels the AVX2 build filters with an explicit four-lane kernel instead
-//! (`cascade.rs`: the same operations per channel). Every build gives the same bits (no
-//! reassociation, no fused multiply-add; tested), so the daemon, training and replay agree
-//! whichever machine runs them.
+//! chosen at run time, for the widest instruction set on x86_64 ([`Simd`]; the `pulp` crate's
+//! safe dispatch). At 4, 8, 12 and 16 channels the AVX2 build filters with an explicit
+//! four-lane kernel instead (`cascade.rs`: the same operations per channel), and with AVX-512
+//! the features take two channels per eight-lane vector (`feature_pairs_x86.rs`: each channel's
+//! four lanes as before). Every build gives the same bits (no reassociation, no fused
+//! multiply-add; tested), so the daemon, training and replay agree whichever machine runs them.
 
 mod batch;
 mod cascade;
@@ -67,6 +68,8 @@ mod chain;
 mod config;
 mod design;
 mod faults;
+#[cfg(target_arch = "x86_64")]
+mod feature_pairs_x86;
 mod feature_passes;
 mod features;
 mod front_end;

@@ -2,9 +2,11 @@
 //!
 //! The filters and features are plain portable loops over fixed 4-lane accumulators (features)
 //! or over the channels (filters). A default x86_64 build may only assume SSE2, two f64 lanes
-//! per instruction; [`Simd::detect`] finds AVX2 at run time (through `pulp`, whose safe API
-//! runs a closure inside a function compiled with those features) and the very same source is
-//! then compiled a second time, four lanes wide.
+//! per instruction; [`Simd::detect`] finds AVX2 or AVX-512 at run time (through `pulp`, whose
+//! safe API runs a closure inside a function compiled with those features) and the very same
+//! source is then compiled a second time, four lanes wide or more. A few kernels are written
+//! with explicit vectors for one instruction set: the filter cascade and the model's
+//! matrix-vector product for AVX2, the features' two-window passes for AVX-512.
 //!
 //! Both builds give the same bits: every operation is an IEEE-754 add, subtract, multiply,
 //! divide, square root or absolute value, each correctly rounded whatever the vector width;
@@ -14,7 +16,7 @@
 //! On aarch64 NEON is part of the baseline, so the portable build is already the vector one.
 
 /// Which build of the inner loops runs: the portable one, or the one for the widest
-/// instruction set the CPU has (AVX2 on x86_64). The same results bit for bit; the choice is
+/// instruction set the CPU has (AVX2 or AVX-512 on x86_64). The same results bit for bit; the choice is
 /// speed only. `Copy`, a few bytes; detected once and kept.
 #[derive(Debug, Clone, Copy)]
 pub struct Simd {
@@ -22,6 +24,9 @@ pub struct Simd {
     /// AVX2 (with the rest of x86-64-v3), for kernels written with explicit vectors.
     #[cfg(target_arch = "x86_64")]
     v3: Option<pulp::x86::V3>,
+    /// AVX-512 (x86-64-v4), for the features' two-window kernel.
+    #[cfg(target_arch = "x86_64")]
+    v4: Option<pulp::x86::V4>,
 }
 
 impl Simd {
@@ -31,6 +36,8 @@ impl Simd {
             arch: Some(pulp::Arch::new()),
             #[cfg(target_arch = "x86_64")]
             v3: pulp::x86::V3::try_new(),
+            #[cfg(target_arch = "x86_64")]
+            v4: pulp::x86::V4::try_new(),
         }
     }
 
@@ -40,7 +47,18 @@ impl Simd {
             arch: None,
             #[cfg(target_arch = "x86_64")]
             v3: None,
+            #[cfg(target_arch = "x86_64")]
+            v4: None,
         }
+    }
+
+    /// This build without its AVX-512 kernels (the AVX2 ones and the dispatched loops stay):
+    /// for tests and benchmarks that compare the kernels on a machine that has AVX-512.
+    pub fn without_avx512(self) -> Simd {
+        #[cfg(target_arch = "x86_64")]
+        return Simd { v4: None, ..self };
+        #[cfg(not(target_arch = "x86_64"))]
+        self
     }
 
     /// The AVX2 token, when this is the dispatched build and the CPU has it: for kernels
@@ -48,6 +66,13 @@ impl Simd {
     #[cfg(target_arch = "x86_64")]
     pub(crate) fn x86_v3(self) -> Option<pulp::x86::V3> {
         self.v3
+    }
+
+    /// The AVX-512 token, when this is the dispatched build and the CPU has it: for kernels
+    /// written with explicit eight-lane vectors.
+    #[cfg(target_arch = "x86_64")]
+    pub(crate) fn x86_v4(self) -> Option<pulp::x86::V4> {
+        self.v4
     }
 
     /// Runs `f`, compiled for the chosen instruction set. Everything `f` calls that should be

@@ -7,7 +7,7 @@
 //! the same final reduction, so each output has the portable bits (no FMA: `V3` only offers
 //! it; here a multiply and an add stay two roundings).
 
-use pulp::x86::{f64x4, V3};
+use pulp::{f64x4, x86::V3};
 
 use super::linalg::dot;
 
