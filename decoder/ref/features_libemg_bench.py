@@ -1,7 +1,8 @@
 """LibEMG's FeatureExtractor on the six features it shares with handstack (issue 15), timed in
 this process's CPU time on the windows of WINDOWS.npy ((n, 12, 200), from
-`libemg_features.py windows`). Prints two JSON lines: one window per call (as online) and one
-call for all windows (batched), each in microseconds of CPU per window. Needs LibEMG (the bench
+`libemg_features.py windows`). Prints three JSON lines: one window per call (as online) over
+all the windows (`online`) and over the first 8 cycled, in cache (`online_hot`), and one call
+for all windows (`batched`), each in microseconds of CPU per window. Needs LibEMG (the bench
 venv of scripts/bench), never the test's .venv.
 
   features_libemg_bench.py WINDOWS.npy
@@ -14,6 +15,10 @@ import numpy as np
 from libemg.feature_extractor import FeatureExtractor
 
 from libemg_features import NAMES, libemg_features
+
+
+# Distinct windows of the `online_hot` measurement (handstack's features_bench uses the same).
+HOT = 8
 
 
 def cpu_per_call(f, calls, rounds=7):
@@ -37,10 +42,13 @@ def main():
     one = [w[i:i + 1] for i in range(len(w))]
     it = iter(range(10**9))
     online = cpu_per_call(lambda: fe.extract_features(NAMES, one[next(it) % len(one)]), 200)
+    # The first HOT windows cycled: the window in cache, as handstack's features_bench `hot`.
+    hot = one[:HOT]
+    online_hot = cpu_per_call(lambda: fe.extract_features(NAMES, hot[next(it) % len(hot)]), 200)
     batched = cpu_per_call(lambda: fe.extract_features(NAMES, w), 3) / len(w)
-    for mode, us in (("online", online), ("batched", batched)):
+    for mode, us in (("online", online), ("online_hot", online_hot), ("batched", batched)):
         print(json.dumps(dict(what="features_window", impl="libemg", mode=mode,
-                              us_cpu_per_window=round(us, 3), windows=len(w),
+                              us_cpu_per_window=round(us, 3), windows=HOT if mode == "online_hot" else len(w),
                               channels=w.shape[1], samples=w.shape[2])))
 
 

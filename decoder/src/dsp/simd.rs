@@ -75,6 +75,21 @@ impl Simd {
         self.v4
     }
 
+    /// The instruction set of the explicit kernels this build runs, for reports: `"AVX-512"`,
+    /// `"AVX2"` or `"portable"` (on aarch64 always `"portable"`, NEON being the baseline).
+    pub fn name(self) -> &'static str {
+        #[cfg(target_arch = "x86_64")]
+        {
+            if self.v4.is_some() {
+                return "AVX-512";
+            }
+            if self.v3.is_some() {
+                return "AVX2";
+            }
+        }
+        "portable"
+    }
+
     /// Runs `f`, compiled for the chosen instruction set. Everything `f` calls that should be
     /// vectorised must be `#[inline(always)]`, so that it is compiled inside `f`.
     #[inline(always)]
