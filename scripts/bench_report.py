@@ -224,7 +224,7 @@ OTHER_ROWS = """| zero heap allocations in the tick | 0 | **0** allocations, 0 r
 | EMG frame decode + reassembly | >= 2 M frames/s | **113 M frames/s** (dispatcher path), the whole front end with E2E 79 M frames/s (AMD EPYC, 2026-12-01; 58-63 and 44-48 M frames/s on the Intel Xeon) | `cargo bench -p hand-dbc --bench emg_decode` |
 | band-pass + notch vs scipy `sosfilt`, same sections, 60 s x 12 ch | equal to 1e-9, faster | equal to 1.5e-14; 1.36 ms vs scipy 5.11-5.81 ms (3.8-4.3x) (AMD EPYC, 2026-12-01; 2.4-3.0x on the Intel Xeon) | `cargo bench -p decoder --bench chain -- filter_60s_12ch_cpu`; `.venv/bin/python decoder/ref/sosfilt_timing.py 20` |
 | features equal to LibEMG's definitions (numpy reference; LibEMG's VAR divides by N, ours by N - 1) | 1e-9 relative | 8.9e-16 on 80 windows of the real 3DC recording, centred and rectified | `cargo test -p decoder --test dsp_scipy features_only` |
-| newest sample -> setpoints on the bus | p99 <= 1 ms | on vcan in the qemu VM: p50 2.6-3.8 ms, **p99 5.2-7.9 ms, not reached** there (the emulator's own wake-up delay); on a board not measured | `./scripts/vm/run` (closed-loop line) |"""
+| newest sample -> setpoints on the bus | p99 <= 1 ms | on vcan in the qemu VM: p50 2.6-3.8 ms, **p99 5.2-7.9 ms, not reached** there (the emulator's own wake-up delay; on the AMD EPYC on 2026-12-01 p50 2.6 ms, p99 5.4 ms); on a board not measured | `./scripts/vm/run` (closed-loop line) |"""
 
 
 def main():
