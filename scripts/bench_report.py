@@ -191,7 +191,7 @@ def footprint_section(path):
     stalls = re.search(r"the machine alone: .*?\| (\d+) in (\d+) wake-ups / (\d+) / (\d+) µs", text)
     during = re.search(r"the loop's misses during the machine's stalls: .*?\| (\d+) of (\d+) \((\d+) of (\d+)\)", text)
     # The hand-kept list of earlier runs: the newest one's misses, in bold.
-    earlier = re.search(r"Earlier runs.*?\*\*(\d+) misses?\*\*", text, re.S)
+    earlier = re.search(r"Earlier runs.*?\*\*(\d+) miss(?:es)?\*\*", text, re.S)
     if not (cpu and rss and miss):
         return ["The footprint: **not measured** (no RELIABILITY.md; run `scripts/bench --long-run`)."]
     cpu_pct = float(cpu.group(1))
