@@ -203,7 +203,7 @@ def footprint_section(path):
     if stalls and during:
         machine = (
             f"; the machine alone (a bare process on a 1 ms grid, same run) stalled over 4 ms "
-            f"{stalls.group(1)} times (longest {int(stalls.group(4)) / 1000:.1f} ms)"
+            f"{stalls.group(1)} time{'' if stalls.group(1) == '1' else 's'} (longest {int(stalls.group(4)) / 1000:.1f} ms)"
         )
         if misses:
             machine += (f", and {during.group(3)} of the {during.group(4)} misses fell in seconds "
