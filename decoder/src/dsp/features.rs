@@ -104,7 +104,7 @@ pub(super) struct Stats {
     n: f64,
     sum_abs: f64,
     sum_sq: f64,
-    /// Sum of |x[i+1] - x[i]| and of (x[i+1] - x[i])^2.
+    /// Sums of `|x[i+1] - x[i]|` and of `(x[i+1] - x[i])^2`.
     wl: f64,
     d_sq: f64,
     /// Sum of squared deviations from the mean (two-pass).
