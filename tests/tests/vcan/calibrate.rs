@@ -8,12 +8,14 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use hand_dbc::messages::{CalibrationCue, EmgSamplesG0, FingerMode, HandHeartbeat};
+use hand_dbc::messages::{CalibrationCue, FingerMode, HandHeartbeat};
 use hand_model::patient::{Target, TrackingConfig};
 use handstack_tests::vcan::monitor::now_us;
 use handstack_tests::vcan::procs::{handctl, handsim};
 use handstack_tests::vcan::{scenario_start_us, setpoints_of, statuses_of, Monitor, Seen};
 use handstack_tests::vcan::{TestConfig, VcanEnv};
+
+use super::wait_for_emg_after;
 
 /// The protocol: rest, flexion and extension of every finger and of the whole hand, two
 /// rounds (the second lets calibrate compare repetitions), short phases: about 2.5 minutes
@@ -75,7 +77,11 @@ pub(super) fn calibrate_deploy_arm(env: &VcanEnv) -> PathBuf {
     // technician arms with the electrodes streaming.
     let t_sine = now_us();
     let mut sine = handsim(env, &dir, "handsim-sine", "sine", 25.0, &[]);
-    wait_for_emg_after(&monitor, t_sine);
+    wait_for_emg_after(
+        &monitor,
+        t_sine,
+        "the sine patient's amplifier never started",
+    );
     handctl(env, &["arm", "--socket", &sock]);
     sine.wait_success(Duration::from_secs(90));
     let seen: Vec<Seen> = monitor
@@ -164,22 +170,6 @@ fn tracking_r2(seen: &[Seen]) -> f64 {
     decoder::eval::tracking_metrics(&target, &tracked)
         .expect("metrics")
         .r2
-}
-
-/// Waits (at most 10 s) for an EMG frame on the bus after `t_us`.
-fn wait_for_emg_after(monitor: &Monitor, t_us: u64) {
-    let begun = std::time::Instant::now();
-    while !monitor
-        .snapshot()
-        .iter()
-        .any(|s| s.time_us >= t_us && s.frame.is_some_and(|f| f.raw_id() == EmgSamplesG0::ID))
-    {
-        assert!(
-            begun.elapsed() < Duration::from_secs(10),
-            "the sine patient's amplifier never started"
-        );
-        std::thread::sleep(Duration::from_millis(100));
-    }
 }
 
 /// What the tracked finger was told over the tracked part of the sine: the first ACTIVE

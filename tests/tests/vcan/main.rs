@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::time::{Duration, Instant};
 
-use hand_dbc::messages::{FingerMode, FingerState};
+use hand_dbc::messages::{EmgSamplesG0, FingerMode, FingerState};
 use hand_model::patient::{Target, TrackingConfig};
 use handstack_tests::vcan::monitor::{now_us, writer};
 use handstack_tests::vcan::procs::{handctl, handsim, DEADLINE_SLACK_MS};
@@ -827,19 +827,20 @@ fn arm_at(rig: &Rig, at_us: u64) -> u64 {
 
 /// Waits until handsim's first EMG sample is on the bus; its receive time (the scenario's 0).
 fn wait_scenario_start(monitor: &Monitor) -> u64 {
+    wait_for_emg_after(monitor, 0, "handsim never started");
+    scenario_start_us(&monitor.snapshot())
+}
+
+/// Waits (at most 10 s, else fails with `what`) for an EMG frame received at or after `t_us`.
+fn wait_for_emg_after(monitor: &Monitor, t_us: u64, what: &str) {
     let begun = Instant::now();
-    loop {
-        let seen = monitor.snapshot();
-        if seen
-            .iter()
-            .any(|s| s.frame.as_ref().is_some_and(|f| f.raw_id() == 0x100))
-        {
-            return scenario_start_us(&seen);
-        }
-        assert!(
-            begun.elapsed() < Duration::from_secs(10),
-            "handsim never started"
-        );
+    while !monitor.snapshot().iter().any(|s| {
+        s.time_us >= t_us
+            && s.frame
+                .as_ref()
+                .is_some_and(|f| f.raw_id() == EmgSamplesG0::ID)
+    }) {
+        assert!(begun.elapsed() < Duration::from_secs(10), "{what}");
         std::thread::sleep(Duration::from_millis(10));
     }
 }
