@@ -68,22 +68,10 @@ fn main() {
         .map(|i| all[i % HOT_WINDOWS.min(all.len())])
         .collect();
     for (mode, windows) in [("streamed", &all), ("hot", &hot)] {
-        let mut rounds: Vec<Duration> = (0..ROUNDS)
-            .map(|_| {
-                let start = ThreadTime::now();
-                for _ in 0..PASSES {
-                    for &w in windows.iter() {
-                        features(simd, black_box(w), channels, &mut out);
-                        black_box(&out);
-                    }
-                }
-                start.elapsed()
-            })
-            .collect();
-        rounds.sort();
-        let calls = (PASSES * windows.len()) as f64;
-        let us = |d: Duration| d.as_secs_f64() * 1e6 / calls;
-        let (median, best) = (us(rounds[ROUNDS / 2]), us(rounds[0]));
+        let (median, best) = time_calls(windows, |w| {
+            features(simd, w, channels, &mut out);
+            black_box(&out);
+        });
         let distinct = if mode == "hot" {
             HOT_WINDOWS.min(n_windows)
         } else {
@@ -101,4 +89,24 @@ fn main() {
             );
         }
     }
+}
+
+/// Median and best over [`ROUNDS`] of the thread's CPU time per call, in µs, of `call` on every
+/// window of `windows`, [`PASSES`] times.
+fn time_calls(windows: &[&[f64]], mut call: impl FnMut(&[f64])) -> (f64, f64) {
+    let mut rounds: Vec<Duration> = (0..ROUNDS)
+        .map(|_| {
+            let start = ThreadTime::now();
+            for _ in 0..PASSES {
+                for &w in windows {
+                    call(black_box(w));
+                }
+            }
+            start.elapsed()
+        })
+        .collect();
+    rounds.sort();
+    let calls = (PASSES * windows.len()) as f64;
+    let us = |d: Duration| d.as_secs_f64() * 1e6 / calls;
+    (us(rounds[ROUNDS / 2]), us(rounds[0]))
 }

@@ -66,34 +66,27 @@ impl PairPass {
         self.d_sq = s.add_f64x8(self.d_sq, s.mul_f64x8(d, d));
     }
 
+    /// Window `w`'s (0 or 1) four lanes of every sum.
+    #[inline(always)]
+    fn half(&self, w: usize) -> FirstPass {
+        FirstPass {
+            sum: split(self.sum)[w],
+            sum_abs: split(self.sum_abs)[w],
+            sum_sq: split(self.sum_sq)[w],
+            wl: split(self.wl)[w],
+            d_sq: split(self.d_sq)[w],
+        }
+    }
+
     /// Each window's [`FirstPass`], its tail (from the whole chunks on) added by the scalar
     /// code.
     #[inline(always)]
     fn finish<const RECTIFIED: bool>(self, x: Pair<'_>, full: usize) -> [FirstPass; 2] {
-        let [sum, sum_abs, sum_sq, wl, d_sq] = [
-            split(self.sum),
-            split(self.sum_abs),
-            split(self.sum_sq),
-            split(self.wl),
-            split(self.d_sq),
-        ];
-        let mut a = FirstPass {
-            sum: sum[0],
-            sum_abs: sum_abs[0],
-            sum_sq: sum_sq[0],
-            wl: wl[0],
-            d_sq: d_sq[0],
-        };
-        let mut b = FirstPass {
-            sum: sum[1],
-            sum_abs: sum_abs[1],
-            sum_sq: sum_sq[1],
-            wl: wl[1],
-            d_sq: d_sq[1],
-        };
-        a.add_tail::<RECTIFIED>(x[0], full * LANES);
-        b.add_tail::<RECTIFIED>(x[1], full * LANES);
-        [a, b]
+        let mut halves = [self.half(0), self.half(1)];
+        for (acc, x) in halves.iter_mut().zip(x) {
+            acc.add_tail::<RECTIFIED>(x, full * LANES);
+        }
+        halves
     }
 }
 

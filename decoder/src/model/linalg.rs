@@ -31,8 +31,8 @@ pub(crate) fn dot(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// Rows of `W x`, one [`dot`] each, compiled inside [`Simd::run`] (on x86_64 with AVX2,
-/// [`super::matvec_x86`] runs instead, four rows at a time); every operation is a correctly rounded multiply or add, so the build changes
-/// speed only.
+/// [`super::matvec_x86`] runs instead, four rows at a time); every operation is a correctly
+/// rounded multiply or add, so the build changes speed only.
 #[inline(always)]
 fn matvec_rows(w: &[f64], x: &[f64], y: &mut [f64]) {
     for (row, yi) in w.chunks_exact(x.len()).zip(y.iter_mut()) {
