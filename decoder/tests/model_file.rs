@@ -7,7 +7,8 @@ use std::path::PathBuf;
 use decoder::dsp::ChainConfig;
 use decoder::model::verify::{Method, VerificationRecord, WorstRay};
 use decoder::model::{
-    train, FileError, ModelKind, ModelSpec, TrainConfig, TrainedModel, HEADER_LEN, MAGIC,
+    train, FileError, ModelKind, ModelSpec, TrainConfig, TrainedModel, ValidationSplit, HEADER_LEN,
+    MAGIC,
 };
 use model_support::{calibration, chain};
 
@@ -18,8 +19,10 @@ fn trained(kind: ModelKind) -> TrainedModel {
     spec.mlp.hidden = [8, 8];
     spec.cnn.filters = [3, 3];
     spec.cnn.dense = 8;
+    // Trials of 4 windows: too short for the default trial-tail split.
     let cfg = TrainConfig {
         max_epochs: 3,
+        split: ValidationSplit::Trial { fraction: 0.2 },
         ..TrainConfig::default()
     };
     train(kind, &spec, &calibration(2, 2, 4, 11), &cfg, &mut |_| {}).expect("trains")

@@ -118,6 +118,7 @@ fn progress_reports_every_epoch_and_early_stopping_keeps_the_best() {
             beta2: 0.999,
             eps: 1e-8,
         },
+        split: ValidationSplit::Trial { fraction: 0.2 },
         ..TrainConfig::default()
     };
     let mut reports: Vec<EpochReport> = Vec::new();
@@ -194,6 +195,23 @@ fn trial_tail_split_holds_out_the_end_of_every_trial_without_overlap() {
     assert_eq!((s.n_val_windows, s.n_train_windows), (44, 143));
     assert_eq!((s.n_val_trials, s.n_train_trials), (11, 11));
     assert!(s.best_val_loss.unwrap() < 0.2, "{s:?}");
+    // A trial too short to split trains whole; with no trial long enough, a clear refusal.
+    let mut mixed = calibration(2, 1, 4, 8);
+    for i in 0..data.len() {
+        if data.trial(i) == 0 {
+            mixed
+                .push(data.row(i), *data.target(i), *data.mask(i), 1_000)
+                .unwrap();
+        }
+    }
+    let m = train(ModelKind::ResDd, &small_spec(), &mixed, &cfg, &mut |_| {}).expect("trains");
+    let s = m.summary();
+    assert_eq!(
+        (s.n_val_windows, s.n_train_windows),
+        (4, 11 * 4 + 13),
+        "{s:?}"
+    );
+    assert_eq!((s.n_val_trials, s.n_train_trials), (1, 12));
     let too_short = calibration(2, 1, 4, 8);
     let e = train(
         ModelKind::ResDd,
@@ -232,7 +250,11 @@ fn refusals_name_the_problem() {
 
     // One trial per label: no trial can be held out without losing that label.
     let single = calibration(2, 1, 4, 5);
-    let e = train(ModelKind::ResDd, &spec, &single, &cfg, &mut |_| {}).unwrap_err();
+    let whole_trials = TrainConfig {
+        split: ValidationSplit::Trial { fraction: 0.2 },
+        ..cfg
+    };
+    let e = train(ModelKind::ResDd, &spec, &single, &whole_trials, &mut |_| {}).unwrap_err();
     assert!(
         matches!(e, TrainError::Split(ref m) if m.contains("repetitions")),
         "{e}"
@@ -276,7 +298,14 @@ fn refusals_name_the_problem() {
     }
     let mut bad_spec = spec;
     bad_spec.resdd.hidden = 0;
-    let e = train(ModelKind::ResDd, &bad_spec, &data, &cfg, &mut |_| {}).unwrap_err();
+    let e = train(
+        ModelKind::ResDd,
+        &bad_spec,
+        &data,
+        &whole_trials,
+        &mut |_| {},
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("hidden width"), "{e}");
 
     let diverge = TrainConfig {

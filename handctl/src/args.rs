@@ -238,15 +238,16 @@ pub struct TrainingOpts {
     /// Seed for initialisation, validation split and shuffling.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Upper bound on training epochs (early stopping on held-out trials may end sooner).
+    /// Upper bound on training epochs (early stopping on held-out windows may end sooner).
     #[arg(long, default_value_t = 200)]
     pub epochs: usize,
     /// Train even when the quality gates find trials to redo.
     #[arg(long)]
     pub ignore_gates: bool,
-    /// Validation split for early stopping: trial (whole trials held out), trial-tail (the
-    /// end of every trial; works with a one-repetition calibration), window or none.
-    #[arg(long, default_value = "trial", value_parser = parse_split)]
+    /// Validation split for early stopping: trial-tail (the end of every trial, so every trial
+    /// also trains; works with a one-repetition calibration), trial (whole trials held out),
+    /// window or none.
+    #[arg(long, default_value = "trial-tail", value_parser = parse_split)]
     pub validation: decoder::model::ValidationSplit,
 }
 

@@ -65,7 +65,7 @@ pub(super) fn describe(model: &TrainedModel) -> String {
     let s = model.summary();
     let val = s
         .best_val_loss
-        .map_or("no held-out trials".to_string(), |v| {
+        .map_or("no held-out windows".to_string(), |v| {
             format!("held-out loss {v:.5}")
         });
     format!(

@@ -60,11 +60,11 @@ pub fn interpolation_table(evals: &[ModelEvaluation], tolerance: f64) -> String 
             .map_or("-".to_string(), |v| format!("{v:.3}"));
         let _ = writeln!(
             s,
-            "{:<7} {:>7} {:>9} {:>11.1}% {:>10.3} {:>8.3} {:>9} {:>10}",
+            "{:<7} {:>7} {:>9} {:>12} {:>10.3} {:>8.3} {:>9} {:>10}",
             e.kind.name(),
             t.curves,
             t.failures,
-            100.0 * t.correct_rate(),
+            format!("{} {:.1}%", t.correct, 100.0 * t.correct_rate()),
             t.mean_spearman,
             t.mean_r2,
             t.constant,

@@ -142,7 +142,7 @@ pub enum ValidationSplit {
 
 impl Default for ValidationSplit {
     fn default() -> Self {
-        ValidationSplit::Trial { fraction: 0.2 }
+        ValidationSplit::TrialTail { fraction: 0.2 }
     }
 }
 
@@ -177,7 +177,7 @@ pub struct TrainConfig {
     pub patience: usize,
     /// Smallest decrease of the validation loss that counts as an improvement (default 1e-6).
     pub min_delta: f64,
-    /// Held-out split for early stopping (default: 20% of trials).
+    /// Held-out split for early stopping (default: the last 20% of every trial).
     pub split: ValidationSplit,
     /// Seed for initialisation, split and shuffling (default 0).
     pub seed: u64,

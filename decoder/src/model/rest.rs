@@ -35,7 +35,7 @@ pub const REST_SHARPNESS: f64 = 4.0;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RestFit {
     /// Quantile of the rest outputs, per finger and side, that sets the dead zone's width
-    /// (default 0.95), in `[0.5, 1]`.
+    /// (default 0.97), in `[0.5, 1]`.
     pub quantile: f64,
     /// Upper bound on either width (default 0.5), in `[0, MAX_REST_WIDTH]`.
     pub max_width: f64,
@@ -44,7 +44,7 @@ pub struct RestFit {
 impl Default for RestFit {
     fn default() -> Self {
         RestFit {
-            quantile: 0.95,
+            quantile: 0.97,
             max_width: 0.5,
         }
     }

@@ -54,26 +54,41 @@ fn window_split(n: usize, fraction: f64, rng: &mut SeededRng) -> Result<Split, T
 }
 
 /// The last `fraction` of every trial's windows held out, the windows that overlap both parts
-/// dropped.
+/// dropped. A trial too short for that (no window to hold out, or none left to train on) trains
+/// whole; an error only when no trial is long enough.
 fn trial_tail_split(d: &Dataset, fraction: f64) -> Result<Split, TrainError> {
     let chain = d.chain();
     // Windows whose samples overlap a given window: ceil(window / step) - 1.
     let gap = ((chain.window_ms / chain.step_ms).ceil() as usize).saturating_sub(1);
+    let held = |m: usize| {
+        let n_val = (fraction * m as f64).round() as usize;
+        (n_val > 0 && n_val + gap < m).then_some(n_val)
+    };
     let mut by_trial: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
     for i in 0..d.len() {
         by_trial.entry(d.trial(i)).or_default().push(i);
     }
     let (mut train, mut val) = (Vec::new(), Vec::new());
-    for (t, idx) in &by_trial {
+    for idx in by_trial.values() {
         let m = idx.len();
-        let n_val = (fraction * m as f64).round() as usize;
-        if n_val == 0 || n_val + gap >= m {
-            return Err(TrainError::Split(format!(
-                "trial {t} has {m} windows: too few to hold out {fraction} of them plus                          {gap} overlapping windows"
-            )));
+        match held(m) {
+            Some(n_val) => {
+                train.extend_from_slice(&idx[..m - n_val - gap]);
+                val.extend_from_slice(&idx[m - n_val..]);
+            }
+            None => train.extend_from_slice(idx),
         }
-        train.extend_from_slice(&idx[..m - n_val - gap]);
-        val.extend_from_slice(&idx[m - n_val..]);
+    }
+    if val.is_empty() {
+        let longest = by_trial.values().map(Vec::len).max().unwrap_or(0);
+        let needed = (1..=10_000)
+            .find(|&m| held(m).is_some())
+            .unwrap_or(usize::MAX);
+        return Err(TrainError::Split(format!(
+            "no trial is long enough to hold out its last {fraction} plus {gap} overlapping \
+             windows: the longest has {longest} windows, {needed} are needed (use the trial \
+             split, or none)"
+        )));
     }
     train.sort_unstable();
     val.sort_unstable();
