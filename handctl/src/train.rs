@@ -48,7 +48,7 @@ pub(super) fn fit(
     let cfg = TrainConfig {
         max_epochs: opts.epochs,
         seed: opts.seed,
-        split: opts.validation,
+        split: opts.validation.unwrap_or(base.split),
         rest: if opts.no_rest_stage { None } else { base.rest },
         ..base
     };

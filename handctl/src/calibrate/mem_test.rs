@@ -190,7 +190,7 @@ fn train_and_summarize(dir: &Path) {
         seed: 0,
         epochs: 200,
         ignore_gates: false,
-        validation: "trial-tail".parse().expect("a split"),
+        validation: None,
     };
     let trained =
         super::training::train_session(dir, &opts, decoder::model::verify::DEFAULT_TOLERANCE)
