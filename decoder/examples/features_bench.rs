@@ -9,8 +9,8 @@
 //! window per call as online, twice: `streamed` (every window in turn, each read from memory
 //! first) and `hot` (the first 8 windows cycled, so the window is in cache, as the daemon's
 //! window is when its tick computes the features); with `--json` one line each,
-//! `{"what":"features_window","impl":"handstack","mode":"hot","us_cpu_per_window":X,...}`. The loops run in
-//! the build for the CPU's widest instruction set ([`Simd::detect`]); `--portable` times the
+//! `{"what":"features_window","impl":"handstack","mode":"hot","us_cpu_per_window":X,...}`.
+//! The loops run in the build for the CPU's widest instruction set ([`Simd::detect`]); `--portable` times the
 //! portable build instead (the same bits). Windows that are all rectified (every value
 //! `>= 0`, checked once before timing, as the bench's are and as the chain's are by default)
 //! go through [`decoder::dsp::multichannel_rectified_features_with`], the chain's own path for

@@ -13,7 +13,7 @@ use pulp::{f64x8, x86::V4};
 
 use super::config::FeatureSignal;
 use super::feature_passes::{add_squared_deviations, lane_sum, whole_chunks, FirstPass, LANES};
-use super::features::{Stats, FEATURES_PER_CHANNEL};
+use super::features::{Stats, StridedWindows, FEATURES_PER_CHANNEL};
 
 /// Two windows (or their chunks) side by side.
 type Pair<'a> = [&'a [f64]; 2];
@@ -171,19 +171,10 @@ fn squared_deviations(s: V4, x: Pair<'_>, means: [f64; 2]) -> [f64; 2] {
 /// [`super::features::strided_features_into`] with AVX-512: the same windows, the same bits.
 pub(super) fn strided_features_into(
     s: V4,
-    data: &[f64],
-    stride: usize,
-    offset: usize,
-    len: usize,
+    windows: StridedWindows<'_>,
     signal: FeatureSignal,
     out: &mut [f64],
 ) {
-    let windows = Windows {
-        data,
-        stride,
-        offset,
-        len,
-    };
     // A `WithSimd` value rather than a closure: every call from here down is
     // `#[inline(always)]`, so all of it is compiled for AVX-512 (a closure's call shim is
     // only an inlining hint and, once the body is large, stays a plain baseline function).
@@ -193,26 +184,10 @@ pub(super) fn strided_features_into(
     }
 }
 
-/// Window `c` of a strided store is `data[c * stride + offset..][..len]`.
-#[derive(Clone, Copy)]
-struct Windows<'a> {
-    data: &'a [f64],
-    stride: usize,
-    offset: usize,
-    len: usize,
-}
-
-impl<'a> Windows<'a> {
-    #[inline(always)]
-    fn get(self, c: usize) -> &'a [f64] {
-        &self.data[c * self.stride + self.offset..][..self.len]
-    }
-}
-
 /// The whole feature computation as one operation for [`pulp::Simd::vectorize`].
 struct Op<'a, const RECTIFIED: bool> {
     s: V4,
-    windows: Windows<'a>,
+    windows: StridedWindows<'a>,
     out: &'a mut [f64],
 }
 
@@ -228,7 +203,7 @@ impl<const RECTIFIED: bool> pulp::WithSimd for Op<'_, RECTIFIED> {
 /// Pair `p`'s first pass beside pair `p - 1`'s second pass; an odd last window goes through
 /// the four-lane passes alone. Every window gets the bits the four-lane code gives it.
 #[inline(always)]
-fn pairs<const RECTIFIED: bool>(s: V4, w: Windows<'_>, out: &mut [f64]) {
+fn pairs<const RECTIFIED: bool>(s: V4, w: StridedWindows<'_>, out: &mut [f64]) {
     if w.len < 2 {
         out.fill(0.0);
         return;

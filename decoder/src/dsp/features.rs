@@ -163,9 +163,13 @@ pub(crate) fn strided_features_into(
 ) {
     #[cfg(target_arch = "x86_64")]
     if let Some(v4) = simd.x86_v4() {
-        return super::feature_pairs_x86::strided_features_into(
-            v4, data, stride, offset, len, signal, out,
-        );
+        let windows = StridedWindows {
+            data,
+            stride,
+            offset,
+            len,
+        };
+        return super::feature_pairs_x86::strided_features_into(v4, windows, signal, out);
     }
     simd.run(
         #[inline(always)]
@@ -174,6 +178,25 @@ pub(crate) fn strided_features_into(
             FeatureSignal::Filtered => strided::<false>(data, stride, offset, len, out),
         },
     )
+}
+
+/// Window `c` of a strided store is `data[c * stride + offset..][..len]`.
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy)]
+pub(super) struct StridedWindows<'a> {
+    pub(super) data: &'a [f64],
+    pub(super) stride: usize,
+    pub(super) offset: usize,
+    pub(super) len: usize,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<'a> StridedWindows<'a> {
+    /// Window `c`.
+    #[inline(always)]
+    pub(super) fn get(self, c: usize) -> &'a [f64] {
+        &self.data[c * self.stride + self.offset..][..self.len]
+    }
 }
 
 /// [`strided_features_into`] for windows that are rectified or not.

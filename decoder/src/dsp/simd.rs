@@ -16,8 +16,8 @@
 //! On aarch64 NEON is part of the baseline, so the portable build is already the vector one.
 
 /// Which build of the inner loops runs: the portable one, or the one for the widest
-/// instruction set the CPU has (AVX2 or AVX-512 on x86_64). The same results bit for bit; the choice is
-/// speed only. `Copy`, a few bytes; detected once and kept.
+/// instruction set the CPU has (AVX2 or AVX-512 on x86_64). The same results bit for bit; the
+/// choice is speed only. `Copy`, a few bytes; detected once and kept.
 #[derive(Debug, Clone, Copy)]
 pub struct Simd {
     arch: Option<pulp::Arch>,

@@ -4,8 +4,9 @@
 //!   run time) share the [`Model`] trait (allocation-free inference with a caller-owned
 //!   [`Scratch`]) and the [`Trainable`] trait (flat parameters and an analytic gradient).
 //! - [`Normalizer`]: per-feature scale, no centring, so zero input stays zero.
-//! - [`Dataset`] + [`train`](fn@train): masked MSE plus the effort-ray penalty ([`EffortPenalty`]), Adam
-//!   or SGD, early stopping on held-out windows (by default the end of every trial), deterministic for a given seed.
+//! - [`Dataset`] + [`train`](fn@train): masked MSE plus the effort-ray penalty
+//!   ([`EffortPenalty`]), Adam or SGD, early stopping on held-out windows (by default the end of
+//!   every trial), deterministic for a given seed.
 //! - [`RestStage`]: a soft dead zone per finger fitted from the calibration's rest windows, so a
 //!   relaxed hand stays still (monotonic, keeps ±1 at ±1).
 //! - [`TrainedModel`]: what a model file holds ([`TrainedModel::save`] / [`TrainedModel::load`]);
