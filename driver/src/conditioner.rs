@@ -1,11 +1,43 @@
-//! The output conditioner and the paper's control law, per finger.
+//! The output conditioner and the control law, per finger: the last stage before the motor.
 //!
 //! A model label goes through clamp -> deadband -> slew limit, then becomes setpoints:
-//! `F = kF·label`, `α = kα·label`, `ω ← clamp(ω + (α − d·ω)·Δt, ±ω_max)`, where the damping `d`
-//! pulls ω toward zero when the label is zero (`d = 0` reproduces the paper's `ω = ω0 + α·t`).
-//! Settings are validated once by the config layer; this code cannot fail.
+//! `F = kF·label` and a joint velocity ω driven by `α = kα·label`:
+//!
+//! ```text
+//! dω/dt = α − d·ω        (d = damping, or the rest damping while the label is zero)
+//! ```
+//!
+//! integrated exactly over each tick (`ω ← ω·e^(−d·Δt) + α·(1 − e^(−d·Δt))/d`), so the update is
+//! stable, and never changes sign by itself, for every damping and tick the config allows (an
+//! explicit Euler step flips sign every tick once `d·Δt > 1` and diverges past 2). ω is then
+//! clamped to ±ω_max.
+//!
+//! The defaults stop a finger when the patient relaxes (no wind-up): with `d = 0` the paper's
+//! law `ω = ω0 + α·t` holds the velocity when the label returns to zero, so after a grip the
+//! finger keeps closing at ω_max, and a rest offset just above the deadband winds up to full
+//! speed. Here ω decays at `damping` while the patient acts (a steady label `x` gives the steady
+//! speed `kα·x/d`: with the defaults full effort just reaches ω_max) and at `rest_damping` while
+//! the label is inside the deadband (2 rad/s falls below 0.05 rad/s within 0.4 s). `damping = 0`
+//! and `rest_damping = 0` give the paper's pure integrator back.
+//!
+//! Further guards, each against a way a finger could move without the patient asking:
+//! - a reported joint limit (FINGER_STATUS fault bit 5: the joint sits at a stop and the command
+//!   pushes into it) stops the integration into that stop: ω may leave the stop, never grow
+//!   into it;
+//! - gains move toward new settings (a live `tune`) at most their full range per `ramp_s`, and
+//!   start from zero after every reset (arm, a model swap, any safe stop), so neither a tune nor a
+//!   restart makes the force jump;
+//! - the slew limit is validated to at most half the label's range per tick (`config`), so one
+//!   window can never reverse a finger.
+//!
+//! Settings are validated once by the config layer; this code cannot fail and does not allocate.
 
 use crate::units::{Newton, RadPerSec, RadPerSec2};
+
+/// Largest kF, N per label unit: the gains' ramp rate is this range per `ramp_s`.
+pub const KF_MAX: f64 = 40.0;
+/// Largest kα, rad/s² per label unit: the gains' ramp rate is this range per `ramp_s`.
+pub const KALPHA_MAX: f64 = 50.0;
 
 /// Per-finger settings of the conditioner and the control law (validated by `config`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,8 +53,27 @@ pub struct FingerGains {
     pub deadband: f64,
     /// Largest change of the conditioned label per second (label units/s).
     pub slew_per_s: f64,
-    /// Velocity damping toward zero, 1/s (0 = off, as in the paper).
+    /// Velocity damping toward zero while the label is not zero, 1/s (0: the paper's law).
     pub damping_per_s: f64,
+    /// Velocity damping toward zero while the label is zero (inside the deadband), 1/s; the
+    /// larger of this and `damping_per_s` applies at rest (0 with `damping_per_s` 0: the
+    /// paper's law).
+    pub rest_damping_per_s: f64,
+    /// Time a gain takes to move across its whole range (kF 0 to [`KF_MAX`], kα 0 to
+    /// [`KALPHA_MAX`]), s: the ramp of a live tune and of every start from rest.
+    pub ramp_s: f64,
+}
+
+impl FingerGains {
+    /// The paper's law: a pure integrator (`ω = ω0 + α·t`, velocity held at rest), gains
+    /// otherwise as given.
+    pub fn paper_law(self) -> Self {
+        Self {
+            damping_per_s: 0.0,
+            rest_damping_per_s: 0.0,
+            ..self
+        }
+    }
 }
 
 impl Default for FingerGains {
@@ -33,7 +84,10 @@ impl Default for FingerGains {
             omega_max: 2.0,
             deadband: 0.05,
             slew_per_s: 10.0,
-            damping_per_s: 0.0,
+            // kα/d = ω_max: full effort's steady speed is the velocity limit.
+            damping_per_s: 1.5,
+            rest_damping_per_s: 10.0,
+            ramp_s: 1.0,
         }
     }
 }
@@ -51,11 +105,37 @@ pub struct Setpoint {
     pub velocity: RadPerSec,
 }
 
-/// The state of one finger's conditioner: the last conditioned label and the integrated velocity.
+/// What the finger's controller last reported that the control law takes into account.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Feedback {
+    /// FINGER_STATUS fault bit 5: the joint is at a stop and the command pushes into it.
+    pub at_joint_limit: bool,
+}
+
+/// The state of one finger's conditioner: the last conditioned label, the integrated velocity,
+/// the gains in force (ramping toward the settings) and the stop the joint sits at.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct FingerConditioner {
     label: f64,
     omega: f64,
+    kf: f64,
+    kalpha: f64,
+    /// +1: the joint sits at its flexion stop, -1 at its extension stop, 0 at neither.
+    stop: i8,
+}
+
+fn approach(x: f64, target: f64, max_step: f64) -> f64 {
+    x + (target - x).clamp(-max_step, max_step)
+}
+
+fn sign(x: f64) -> i8 {
+    if x > 0.0 {
+        1
+    } else if x < 0.0 {
+        -1
+    } else {
+        0
+    }
 }
 
 impl FingerConditioner {
@@ -63,7 +143,13 @@ impl FingerConditioner {
     ///
     /// A non-finite label is treated as zero: the caller reports it as a fault, and the hand must
     /// not move on it.
-    pub fn step(&mut self, raw: f64, gains: &FingerGains, dt_s: f64) -> Setpoint {
+    pub fn step(
+        &mut self,
+        raw: f64,
+        gains: &FingerGains,
+        dt_s: f64,
+        feedback: Feedback,
+    ) -> Setpoint {
         let x = if raw.is_finite() {
             raw.clamp(-1.0, 1.0)
         } else {
@@ -72,18 +158,46 @@ impl FingerConditioner {
         let x = deadband(x, gains.deadband);
         let max_step = gains.slew_per_s * dt_s;
         self.label += (x - self.label).clamp(-max_step, max_step);
-        let alpha = gains.kalpha * self.label;
-        let omega = self.omega + (alpha - gains.damping_per_s * self.omega) * dt_s;
-        self.omega = omega.clamp(-gains.omega_max, gains.omega_max);
+
+        let ramp = dt_s / gains.ramp_s;
+        self.kf = approach(self.kf, gains.kf, KF_MAX * ramp);
+        self.kalpha = approach(self.kalpha, gains.kalpha, KALPHA_MAX * ramp);
+
+        let alpha = self.kalpha * self.label;
+        let d = if self.label == 0.0 {
+            gains.damping_per_s.max(gains.rest_damping_per_s)
+        } else {
+            gains.damping_per_s
+        };
+        self.omega = decay(self.omega, alpha, d, dt_s).clamp(-gains.omega_max, gains.omega_max);
+        self.hold_at_stop(feedback);
         Setpoint {
             label: self.label,
-            force: Newton(gains.kf * self.label),
+            force: Newton(self.kf * self.label),
             alpha: RadPerSec2(alpha),
             velocity: RadPerSec(self.omega),
         }
     }
 
-    /// Forget the label and velocity: after a safe stop the finger starts again from rest.
+    /// At a reported joint limit the velocity may leave the stop, never grow into it. The stop
+    /// is the one the finger was moving toward when the limit was first reported.
+    fn hold_at_stop(&mut self, feedback: Feedback) {
+        if !feedback.at_joint_limit {
+            self.stop = 0;
+            return;
+        }
+        if self.stop == 0 {
+            self.stop = sign(self.omega);
+        }
+        match self.stop {
+            1 => self.omega = self.omega.min(0.0),
+            -1 => self.omega = self.omega.max(0.0),
+            _ => {}
+        }
+    }
+
+    /// Forget the label, velocity and gains: after a safe stop (and at arm, and after a model
+    /// swap) the finger starts again from rest, its gains ramping in from zero.
     pub fn reset(&mut self) {
         *self = Self::default();
     }
@@ -92,6 +206,21 @@ impl FingerConditioner {
     pub fn omega(&self) -> f64 {
         self.omega
     }
+
+    /// The force gain in force now (ramping toward the setting), N per label unit.
+    pub fn kf(&self) -> f64 {
+        self.kf
+    }
+}
+
+/// `dω/dt = α − d·ω` integrated exactly over `dt` with α constant: stable for every `d ≥ 0`.
+fn decay(omega: f64, alpha: f64, d: f64, dt: f64) -> f64 {
+    if d == 0.0 {
+        return omega + alpha * dt;
+    }
+    let k = (-d * dt).exp();
+    // (1 − e^(−d·dt))/d without cancellation for small d·dt.
+    omega * k + alpha * (-(-d * dt).exp_m1()) / d
 }
 
 fn deadband(x: f64, band: f64) -> f64 {
@@ -104,91 +233,4 @@ fn deadband(x: f64, band: f64) -> f64 {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn gains() -> FingerGains {
-        FingerGains {
-            kf: 8.0,
-            kalpha: 3.0,
-            omega_max: 1.0,
-            deadband: 0.1,
-            slew_per_s: 1000.0,
-            damping_per_s: 0.0,
-        }
-    }
-
-    #[test]
-    fn force_is_kf_times_label_and_deadband_is_continuous() {
-        let mut c = FingerConditioner::default();
-        let g = gains();
-        assert_eq!(c.step(0.05, &g, 0.05).force, Newton(0.0));
-        let sp = c.step(1.0, &g, 0.05);
-        assert!((sp.force.0 - 8.0).abs() < 1e-12);
-        let sp = c.step(0.55, &g, 0.05);
-        assert!((sp.label - 0.5).abs() < 1e-12, "{}", sp.label);
-        let sp = c.step(-3.0, &g, 0.05);
-        assert!(
-            (sp.label + 1.0).abs() < 1e-12,
-            "clamped to -1, got {}",
-            sp.label
-        );
-    }
-
-    #[test]
-    fn velocity_integrates_alpha_and_saturates() {
-        let mut c = FingerConditioner::default();
-        let g = gains();
-        let sp = c.step(1.0, &g, 0.05);
-        assert!((sp.velocity.0 - 0.15).abs() < 1e-12);
-        for _ in 0..100 {
-            c.step(1.0, &g, 0.05);
-        }
-        assert_eq!(c.omega(), 1.0);
-        // Without damping the paper's law holds the velocity when the label returns to zero.
-        let sp = c.step(0.0, &g, 0.05);
-        assert_eq!(sp.velocity.0, 1.0);
-    }
-
-    #[test]
-    fn damping_pulls_velocity_to_zero_at_rest() {
-        let mut c = FingerConditioner::default();
-        let g = FingerGains {
-            damping_per_s: 4.0,
-            ..gains()
-        };
-        for _ in 0..20 {
-            c.step(1.0, &g, 0.05);
-        }
-        let before = c.omega();
-        for _ in 0..40 {
-            c.step(0.0, &g, 0.05);
-        }
-        assert!(
-            before > 0.5 && c.omega().abs() < 0.01,
-            "{before} -> {}",
-            c.omega()
-        );
-    }
-
-    #[test]
-    fn slew_limit_bounds_the_change_per_tick() {
-        let mut c = FingerConditioner::default();
-        let g = FingerGains {
-            slew_per_s: 2.0,
-            deadband: 0.0,
-            ..gains()
-        };
-        let sp = c.step(1.0, &g, 0.05);
-        assert!((sp.label - 0.1).abs() < 1e-12);
-        let sp = c.step(-1.0, &g, 0.05);
-        assert!(sp.label.abs() < 1e-12);
-    }
-
-    #[test]
-    fn non_finite_label_commands_nothing() {
-        let mut c = FingerConditioner::default();
-        let sp = c.step(f64::NAN, &gains(), 0.05);
-        assert_eq!(sp, Setpoint::default());
-    }
-}
+mod tests;

@@ -21,17 +21,23 @@ pub const DEFAULT_CONFIG_PATH: &str = "/etc/handstack/handd.toml";
 /// ranges of hand.dbc, so a valid config can never ask for a value the bus cannot carry.
 pub mod limits {
     /// kF, N per label unit.
-    pub const KF: (f64, f64) = (0.0, 40.0);
+    pub const KF: (f64, f64) = (0.0, crate::conditioner::KF_MAX);
     /// kα, rad/s² per label unit.
-    pub const KALPHA: (f64, f64) = (0.0, 50.0);
+    pub const KALPHA: (f64, f64) = (0.0, crate::conditioner::KALPHA_MAX);
     /// ω_max, rad/s.
     pub const OMEGA_MAX: (f64, f64) = (0.01, 10.0);
     /// Deadband, label units.
     pub const DEADBAND: (f64, f64) = (0.0, 0.5);
     /// Slew limit, label units per second.
     pub const SLEW: (f64, f64) = (0.1, 100.0);
-    /// Velocity damping, 1/s.
+    /// Velocity damping (while acting and at rest), 1/s.
     pub const DAMPING: (f64, f64) = (0.0, 50.0);
+    /// Time a gain ramps across its whole range, s.
+    pub const RAMP_S: (f64, f64) = (0.1, 10.0);
+    /// Largest label change per tick the slew limit may allow (`slew · tick`): half the
+    /// label's range, so a sign reversal (+1 to -1) takes at least four ticks and no single
+    /// window, however wrong, can reverse a finger.
+    pub const SLEW_PER_TICK_MAX: f64 = 0.5;
     /// Tick period, ms.
     pub const TICK_MS: (u64, u64) = (10, 100);
     /// EMG silence and finger silence timeouts, ms.
@@ -91,8 +97,13 @@ pub struct FingerConfig {
     pub deadband: f64,
     /// Slew limit on the label, per second.
     pub slew: f64,
-    /// Velocity damping toward zero, 1/s (0 reproduces the paper).
+    /// Velocity damping toward zero while the patient acts, 1/s (0 with `rest_damping` 0
+    /// reproduces the paper's pure integrator).
     pub damping: f64,
+    /// Velocity damping toward zero while the label is inside the deadband, 1/s.
+    pub rest_damping: f64,
+    /// Seconds a gain takes to ramp across its whole range (a live tune, every start from rest).
+    pub ramp_s: f64,
 }
 
 impl Default for FingerConfig {
@@ -105,6 +116,8 @@ impl Default for FingerConfig {
             deadband: g.deadband,
             slew: g.slew_per_s,
             damping: g.damping_per_s,
+            rest_damping: g.rest_damping_per_s,
+            ramp_s: g.ramp_s,
         }
     }
 }
@@ -119,6 +132,8 @@ impl FingerConfig {
             deadband: self.deadband,
             slew_per_s: self.slew,
             damping_per_s: self.damping,
+            rest_damping_per_s: self.rest_damping,
+            ramp_s: self.ramp_s,
         }
     }
 }
@@ -278,7 +293,26 @@ impl FingerConfig {
         check_f64(format!("{name}.omega_max"), self.omega_max, OMEGA_MAX)?;
         check_f64(format!("{name}.deadband"), self.deadband, DEADBAND)?;
         check_f64(format!("{name}.slew"), self.slew, SLEW)?;
-        check_f64(format!("{name}.damping"), self.damping, DAMPING)
+        check_f64(format!("{name}.damping"), self.damping, DAMPING)?;
+        check_f64(format!("{name}.rest_damping"), self.rest_damping, DAMPING)?;
+        check_f64(format!("{name}.ramp_s"), self.ramp_s, RAMP_S)
+    }
+
+    /// The slew limit against the tick: at most [`limits::SLEW_PER_TICK_MAX`] per tick.
+    pub fn validate_slew(&self, name: &str, tick_ms: u64) -> Result<(), ConfigError> {
+        let per_tick = self.slew * tick_ms as f64 * 1e-3;
+        if per_tick <= limits::SLEW_PER_TICK_MAX + 1e-12 {
+            return Ok(());
+        }
+        Err(ConfigError::Invalid {
+            field: format!("{name}.slew"),
+            value: self.slew.to_string(),
+            allowed: format!(
+                "at most {} per second with tick_ms = {tick_ms} (half the label's range per \
+                 tick, so that no single window can reverse a finger)",
+                limits::SLEW_PER_TICK_MAX / (tick_ms as f64 * 1e-3)
+            ),
+        })
     }
 }
 
@@ -334,7 +368,9 @@ impl Config {
         )?;
         check_u64("timeouts.recovery_ms", t.recovery_ms, limits::RECOVERY_MS)?;
         for (f, name) in FINGER_NAMES.iter().enumerate().take(N_FINGERS) {
-            self.fingers.get(f).validate(&format!("fingers.{name}"))?;
+            let finger = self.fingers.get(f);
+            finger.validate(&format!("fingers.{name}"))?;
+            finger.validate_slew(&format!("fingers.{name}"), self.tick_ms)?;
         }
         if self.control.socket.as_os_str().is_empty() {
             return Err(ConfigError::Invalid {
@@ -383,8 +419,16 @@ impl fmt::Display for FingerConfig {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "kf={} N kalpha={} rad/s² omega_max={} rad/s deadband={} slew={}/s damping={}/s",
-            self.kf, self.kalpha, self.omega_max, self.deadband, self.slew, self.damping
+            "kf={} N kalpha={} rad/s² omega_max={} rad/s deadband={} slew={}/s damping={}/s \
+             rest_damping={}/s ramp_s={} s",
+            self.kf,
+            self.kalpha,
+            self.omega_max,
+            self.deadband,
+            self.slew,
+            self.damping,
+            self.rest_damping,
+            self.ramp_s
         )
     }
 }
@@ -453,6 +497,24 @@ mod tests {
         assert!(msg.contains("h.toml") && msg.contains("line 1"), "{msg}");
         let e = Config::from_toml("kf = nan\n", Path::new("h.toml")).unwrap_err();
         assert!(matches!(e, ConfigError::Parse { .. }), "{e}");
+    }
+
+    #[test]
+    fn a_slew_that_allows_more_than_half_the_range_per_tick_is_refused() {
+        // 10/s at 50 ms is 0.5 per tick: the most allowed; 12/s is 0.6: refused.
+        let ok = "tick_ms = 50\n[fingers.middle]\nslew = 10.0\n";
+        Config::from_toml(ok, Path::new("h.toml")).unwrap();
+        let bad = "tick_ms = 50\n[fingers.middle]\nslew = 12.0\n";
+        let e = Config::from_toml(bad, Path::new("h.toml")).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.contains("fingers.middle.slew") && msg.contains("10 per second"),
+            "{msg}"
+        );
+        // The default slew (10/s) at the longest tick (100 ms) is 1.0 per tick: refused, with
+        // the most that tick allows.
+        let e = Config::from_toml("tick_ms = 100\n", Path::new("h.toml")).unwrap_err();
+        assert!(e.to_string().contains("at most 5 per second"), "{e}");
     }
 
     #[test]

@@ -235,7 +235,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
                 // Frames of the old epoch may still be queued where we cannot purge them.
                 self.engine.new_epoch();
                 tracing::warn!(
-                    epoch = self.engine.epoch(),
+                    epochs = ?self.engine.epochs(),
                     "bus reopened in a new setpoint epoch; the daemon stays SAFE until `handctl arm`"
                 );
                 self.bus_ok = true;

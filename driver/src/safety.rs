@@ -78,11 +78,14 @@ pub enum Fault {
     Calibrating,
     /// The daemon started without a model file: nothing drives the hand until `handctl deploy`.
     NoModel,
+    /// A model was swapped in (a deploy or a rollback): the hand waits in SAFE, every finger
+    /// from rest, until `arm` hands it to the new model.
+    ModelSwapped,
 }
 
 impl Fault {
     /// All faults, in bit order.
-    pub const ALL: [Fault; 13] = [
+    pub const ALL: [Fault; 14] = [
         Fault::EmgSilence,
         Fault::E2eError,
         Fault::InvalidWindow,
@@ -96,6 +99,7 @@ impl Fault {
         Fault::StopRequested,
         Fault::Calibrating,
         Fault::NoModel,
+        Fault::ModelSwapped,
     ];
 
     /// Whether the fault stays until `handctl arm`.
@@ -110,6 +114,7 @@ impl Fault {
                 | Fault::StopRequested
                 | Fault::Calibrating
                 | Fault::NoModel
+                | Fault::ModelSwapped
         )
     }
 
@@ -134,6 +139,7 @@ impl Fault {
             Fault::StopRequested => "stop_requested",
             Fault::Calibrating => "calibrating",
             Fault::NoModel => "no_model",
+            Fault::ModelSwapped => "model_swapped",
         }
     }
 }

@@ -60,7 +60,7 @@ fn ignored(r: &Rig) -> u64 {
 /// After the bus comes back: a stale frame of `old` leaves the finger where it is and is
 /// counted; the same frame in the current epoch moves it (the control).
 fn stale_is_ignored_and_current_moves(r: &mut Rig, old: u16) {
-    let current = r.runner.engine().epoch();
+    let current = r.runner.engine().epoch(FINGER);
     assert_ne!(
         current, old,
         "handd came back in the epoch of before the bus-off"
@@ -96,7 +96,7 @@ fn a_stale_setpoint_after_a_short_bus_off_does_not_move_the_finger() {
     let mut r = Rig::new(FaultPlan::new(), Script::resting(20_000_000));
     r.run_until(ONSET);
     assert_eq!(r.runner.engine().state(), DaemonState::Running);
-    let old = r.runner.engine().epoch();
+    let old = r.runner.engine().epoch(FINGER);
     assert_eq!(
         last_setpoint(&r, FINGER).epoch(),
         old,
@@ -112,7 +112,10 @@ fn a_stale_setpoint_after_a_short_bus_off_does_not_move_the_finger() {
     r.run_until(ONSET + 2 * TICK + 1_000);
     let f = r.world.fingers().nth(FINGER).expect("finger");
     assert_eq!(f.epoch_gate().retired(), Some(old), "old epoch retired");
-    assert_eq!(f.epoch_gate().bound(), Some(r.runner.engine().epoch()));
+    assert_eq!(
+        f.epoch_gate().bound(),
+        Some(r.runner.engine().epoch(FINGER))
+    );
     stale_is_ignored_and_current_moves(&mut r, old);
 }
 
@@ -120,7 +123,7 @@ fn a_stale_setpoint_after_a_short_bus_off_does_not_move_the_finger() {
 fn a_stale_setpoint_after_a_long_bus_off_does_not_move_the_finger_and_arm_resumes() {
     let mut r = Rig::new(FaultPlan::new(), Script::resting(20_000_000));
     r.run_until(ONSET);
-    let old = r.runner.engine().epoch();
+    let old = r.runner.engine().epoch(FINGER);
     // 500 ms off: every controller brakes by itself and retires the old epoch.
     r.bus.set_bus_off(true);
     r.run_until(ONSET + 500_000);
@@ -142,7 +145,7 @@ fn after_a_stall_that_brakes_the_controllers_handd_reopens_them_in_a_new_epoch()
     let mut r = Rig::new(FaultPlan::new(), Script::resting(20_000_000));
     r.run_until(ONSET);
     assert_eq!(r.runner.engine().state(), DaemonState::Running);
-    let begun = r.runner.engine().epochs_begun();
+    let begun = r.runner.engine().epochs_begun(FINGER);
     // handd stalls 300 ms (no bus fault): the world runs on, the controllers brake by
     // themselves and retire handd's epoch.
     let mut now = r.clock_now();
@@ -156,7 +159,7 @@ fn after_a_stall_that_brakes_the_controllers_handd_reopens_them_in_a_new_epoch()
     r.run_until(ONSET + 1_500_000);
     assert_eq!(r.runner.engine().state(), DaemonState::Running);
     assert!(
-        r.runner.engine().epochs_begun() > begun,
+        r.runner.engine().epochs_begun(FINGER) > begun,
         "the controllers' self-brake reports start a new epoch"
     );
     for f in r.world.fingers() {
@@ -166,6 +169,9 @@ fn after_a_stall_that_brakes_the_controllers_handd_reopens_them_in_a_new_epoch()
             "finger {} again",
             f.finger()
         );
-        assert_eq!(f.epoch_gate().bound(), Some(r.runner.engine().epoch()));
+        assert_eq!(
+            f.epoch_gate().bound(),
+            Some(r.runner.engine().epoch(f.finger()))
+        );
     }
 }

@@ -128,10 +128,12 @@ fn estop_stops_within_100ms_and_latches() {
 }
 
 #[test]
-fn silent_finger_controller_disables_that_finger_alone() {
+fn silent_finger_controller_safe_stops_that_finger_alone() {
     let mut r = rig(Fault::MotorSilent { finger: 2 }, ONSET + 500_000);
     let dt = time_to_stop(&mut r, 300_000, Some(2));
-    // Disabling needs 100 ms of silence by definition, then the next tick sends it.
+    // Taking the finger out needs 100 ms of silence by definition, then the next tick sends its
+    // SAFE_STOP (never DISABLED: a controller handd cannot hear may still hear handd, and
+    // DISABLED would let its finger coast).
     assert!(dt <= 100_000 + TICK, "{dt} us");
     let after: Vec<_> = r
         .setpoints()
@@ -141,7 +143,7 @@ fn silent_finger_controller_disables_that_finger_alone() {
     assert!(after
         .iter()
         .filter(|s| s.1 == 2)
-        .all(|s| s.2 == FingerMode::Disabled));
+        .all(|s| s.2 == FingerMode::SafeStop));
     assert!(
         after
             .iter()
@@ -243,18 +245,14 @@ fn bus_off_stops_sending_drops_stale_setpoints_and_comes_back_safe() {
         "sending resumed after the bus came back"
     );
     assert!(!after.is_empty());
-    // Fingers whose status frames went unread while the bus was off come back DISABLED:
-    // zero force and velocity either way, never a stale ACTIVE setpoint.
+    // Every finger gets SAFE_STOP with zero force and velocity, the ones whose status frames
+    // went unread while the bus was off too: never a stale ACTIVE setpoint, never DISABLED.
     assert!(
-        after.iter().all(
-            |s| matches!(s.2, FingerMode::SafeStop | FingerMode::Disabled)
-                && s.3 == 0.0
-                && s.4 == 0.0
-        ),
-        "back in SAFE, nothing stale: {:?}",
         after
             .iter()
-            .find(|s| !matches!(s.2, FingerMode::SafeStop | FingerMode::Disabled))
+            .all(|s| s.2 == FingerMode::SafeStop && s.3 == 0.0 && s.4 == 0.0),
+        "back in SAFE, nothing stale: {:?}",
+        after.iter().find(|s| s.2 != FingerMode::SafeStop)
     );
     let now = r.clock_now();
     r.runner.engine_mut().command(now, Command::Arm).unwrap();

@@ -270,6 +270,17 @@ fn calibrating_hold_deploy_refusals_swap_and_rollback() {
     // What the live lines (`handctl monitor`) say of the running model.
     let live_id = || live.lock().unwrap().info.id.clone();
 
+    // A swap over a running model latches model_swapped: arm once the signal is validated.
+    rig.run_until(700_000);
+    assert!(rig
+        .runner
+        .engine()
+        .faults()
+        .contains(driver::safety::Fault::ModelSwapped));
+    rig.runner
+        .engine_mut()
+        .command(700_000, LoopCommand::Arm)
+        .unwrap();
     rig.run_until(2_000_000);
     assert!(heartbeat_ids(&rig, 0).iter().all(|h| h.1 == id_a));
     let ask = |req: Request| request(&sock, &req).unwrap();
@@ -396,6 +407,20 @@ fn calibrating_hold_deploy_refusals_swap_and_rollback() {
     );
     assert_eq!(Config::load(&config_path).unwrap().model, config.model);
     assert_eq!(live_id(), format!("{id_a:08x}"), "the live lines' model");
+    // The rollback took over a moving hand: safe stops from the tick after it until `arm`.
+    let until = rig.clock_now();
+    assert!(
+        modes_seen(&rig, back_at + 100_000, until)
+            .iter()
+            .all(|m| *m == FingerMode::SafeStop),
+        "the hand moved under the rolled-back model before arm"
+    );
+    assert!(
+        matches!(ask(Request::Arm), Reply::Ok { .. }),
+        "arm after the rollback"
+    );
+    rig.run_until(until + 2_000_000);
+    assert!(modes_seen(&rig, until, rig.clock_now()).contains(&FingerMode::Active));
     let audit = std::fs::read_to_string(dir.join("audit.log")).unwrap();
     for want in [
         "calibrating",

@@ -1,15 +1,17 @@
 //! handd's side of the setpoint epoch (hand.dbc, FINGER_SETPOINT's `Epoch`): no stale
-//! setpoint can move a finger.
+//! setpoint can move a finger, and one finger's fault stays its own.
 //!
-//! Every setpoint carries the current epoch. The engine starts at a fresh, unpredictable
-//! epoch ([`fresh_epoch`]) and takes the next one (+1, wrapping) on every change of state into
-//! SAFE, on every bus recovery (the daemon calls [`super::Engine::new_epoch`] after a reopen)
-//! and when a finger controller reports that it braked by itself (FINGER_STATUS BRAKED with
-//! the setpoint-timeout bit, on the report's rising edge). In each epoch a finger gets a
-//! SAFE_STOP before anything else (DISABLED included): the controller opens an epoch only on a
-//! SAFE_STOP, and ignores every setpoint of another epoch, so frames of an older epoch still
-//! queued in the kernel or in a CAN controller's mailboxes cannot move the finger once the
-//! new epoch's SAFE_STOP has reached it.
+//! Every setpoint carries its finger's current epoch: handd keeps one epoch per finger. The
+//! engine starts every finger at a fresh, unpredictable epoch ([`fresh_epoch`]) and moves
+//! *every* finger to its next one (+1, wrapping) on every change of state into SAFE and on every
+//! bus recovery (the daemon calls [`super::Engine::new_epoch`] after a reopen), but only finger f
+//! when finger f's controller reports that it braked by itself (FINGER_STATUS BRAKED with the
+//! setpoint-timeout bit, on the report's rising edge): that controller retired its epoch, the
+//! others did not, and they keep their force. In each of its epochs a finger gets a SAFE_STOP
+//! before anything else (DISABLED included): the controller opens an epoch only on a SAFE_STOP,
+//! and ignores every setpoint of another epoch, so frames of an older epoch still queued in the
+//! kernel or in a CAN controller's mailboxes cannot move the finger once the new epoch's
+//! SAFE_STOP has reached it.
 
 use std::hash::{BuildHasher, Hasher};
 
@@ -30,52 +32,64 @@ pub fn fresh_epoch() -> u16 {
     (x ^ (x >> 16) ^ (x >> 32) ^ (x >> 48)) as u16
 }
 
-/// The current epoch and which fingers it was opened for.
+/// Each finger's current epoch and whether it was opened.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) struct Epochs {
-    epoch: u16,
-    /// Finger f got a SAFE_STOP of this epoch.
+    epoch: [u16; N_FINGERS],
+    /// Finger f got a SAFE_STOP of its current epoch.
     opened: [bool; N_FINGERS],
     /// Finger f's last status said it braked by itself.
     self_braked: [bool; N_FINGERS],
-    /// Epochs begun since start, the first included.
-    begun: u64,
+    /// Epochs begun since start, per finger, the first included.
+    begun: [u64; N_FINGERS],
 }
 
 impl Epochs {
-    pub(super) fn new(epoch: u16) -> Self {
+    pub(super) fn new(epochs: [u16; N_FINGERS]) -> Self {
         Self {
-            epoch,
+            epoch: epochs,
             opened: [false; N_FINGERS],
             self_braked: [false; N_FINGERS],
-            begun: 1,
+            begun: [1; N_FINGERS],
         }
     }
 
-    /// The epoch the setpoints carry now.
-    pub(super) fn current(&self) -> u16 {
+    /// The epoch finger `f`'s setpoints carry now.
+    pub(super) fn current(&self, f: usize) -> u16 {
+        self.epoch[f]
+    }
+
+    /// Every finger's epoch now.
+    pub(super) fn all(&self) -> [u16; N_FINGERS] {
         self.epoch
     }
 
-    /// Epochs begun since start.
-    pub(super) fn begun(&self) -> u64 {
-        self.begun
+    /// Epochs finger `f` began since start.
+    pub(super) fn begun(&self, f: usize) -> u64 {
+        self.begun[f]
     }
 
-    /// Starts `epoch`: no finger has had its SAFE_STOP yet.
-    pub(super) fn begin(&mut self, epoch: u16) {
-        self.epoch = epoch;
-        self.opened = [false; N_FINGERS];
-        self.begun += 1;
+    /// Starts `epoch` for finger `f`: it has not had its SAFE_STOP yet.
+    pub(super) fn begin(&mut self, f: usize, epoch: u16) {
+        self.epoch[f] = epoch;
+        self.opened[f] = false;
+        self.begun[f] += 1;
     }
 
-    /// Starts the next epoch.
+    /// Starts finger `f`'s next epoch.
+    pub(super) fn next_for(&mut self, f: usize) {
+        self.begin(f, self.epoch[f].wrapping_add(1));
+    }
+
+    /// Starts every finger's next epoch.
     pub(super) fn next(&mut self) {
-        self.begin(self.epoch.wrapping_add(1));
+        for f in 0..N_FINGERS {
+            self.next_for(f);
+        }
     }
 
     /// The mode to send finger `f` when the engine wants `wanted`: a SAFE_STOP in place of
-    /// anything else until the finger got one in this epoch. DISABLED too: a controller that
+    /// anything else until the finger got one in its epoch. DISABLED too: a controller that
     /// handd cannot hear may still hear handd, and it must leave its old epoch.
     pub(super) fn mode(&mut self, f: usize, wanted: FingerMode) -> FingerMode {
         if self.opened[f] {
@@ -86,12 +100,17 @@ impl Epochs {
     }
 
     /// Finger `f` reported its state: true when it newly says it braked by itself, which
-    /// calls for a new epoch (it retired the current one).
+    /// calls for a new epoch for that finger (it retired its current one).
     pub(super) fn on_status(&mut self, f: usize, braked_by_itself: bool) -> bool {
         let rising = braked_by_itself && !self.self_braked[f];
         self.self_braked[f] = braked_by_itself;
         rising
     }
+}
+
+/// Five fresh epochs, one per finger.
+pub fn fresh_epochs() -> [u16; N_FINGERS] {
+    std::array::from_fn(|_| fresh_epoch())
 }
 
 #[cfg(test)]
@@ -101,7 +120,7 @@ mod tests {
 
     #[test]
     fn each_epoch_opens_every_finger_with_a_safe_stop_first() {
-        let mut e = Epochs::new(65535);
+        let mut e = Epochs::new([65535; N_FINGERS]);
         for f in 0..N_FINGERS {
             assert_eq!(
                 e.mode(f, Active),
@@ -112,8 +131,8 @@ mod tests {
             assert_eq!(e.mode(f, Hold), Hold);
         }
         e.next();
-        assert_eq!(e.current(), 0, "wraps");
-        assert_eq!(e.begun(), 2);
+        assert_eq!(e.all(), [0; N_FINGERS], "wraps");
+        assert_eq!(e.begun(3), 2);
         assert_eq!(
             e.mode(1, Disabled),
             SafeStop,
@@ -131,13 +150,29 @@ mod tests {
 
     #[test]
     fn only_the_rising_edge_of_a_self_brake_report_calls_for_a_new_epoch() {
-        let mut e = Epochs::new(3);
+        let mut e = Epochs::new([3; N_FINGERS]);
         assert!(!e.on_status(0, false));
         assert!(e.on_status(0, true));
         assert!(!e.on_status(0, true), "the same brake, reported again");
         assert!(e.on_status(1, true), "another finger");
         assert!(!e.on_status(0, false));
         assert!(e.on_status(0, true), "a new brake");
+    }
+
+    #[test]
+    fn a_fingers_own_epoch_moves_alone() {
+        let mut e = Epochs::new([10, 20, 30, 40, 50]);
+        for f in 0..N_FINGERS {
+            e.mode(f, Active);
+        }
+        e.next_for(2);
+        assert_eq!(e.all(), [10, 20, 31, 40, 50]);
+        assert_eq!((e.begun(2), e.begun(1)), (2, 1));
+        for f in [0, 1, 3, 4] {
+            assert_eq!(e.mode(f, Active), Active, "finger {f} keeps its epoch open");
+        }
+        assert_eq!(e.mode(2, Active), SafeStop, "only finger 2 is reopened");
+        assert_eq!(e.mode(2, Active), Active);
     }
 
     #[test]

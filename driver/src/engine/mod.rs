@@ -20,14 +20,14 @@ mod rx;
 mod swap;
 mod tx;
 
-pub use epoch::fresh_epoch;
+pub use epoch::{fresh_epoch, fresh_epochs};
 pub use swap::{Hold, ModelSwap};
 
 use decoder::dsp::ChainSettings;
 use decoder::model::Predictor;
 use hand_dbc::CanFrame;
 
-use crate::conditioner::{FingerConditioner, FingerGains, Setpoint};
+use crate::conditioner::{Feedback, FingerConditioner, FingerGains, Setpoint};
 use crate::safety::{
     DaemonState, Fault, FaultSet, FingerEvent, FingerWatch, Safety, SafetyTiming, Transition,
 };
@@ -193,7 +193,7 @@ impl Engine {
             counters: Counters::default(),
             timing: TickTiming::default(),
             tx: tx::Tx::new(),
-            epochs: epoch::Epochs::new(fresh_epoch()),
+            epochs: epoch::Epochs::new(fresh_epochs()),
             transitions: [None; 8],
             finger_events: [None; N_FINGERS],
             settings,
@@ -211,25 +211,30 @@ impl Engine {
         }
     }
 
-    /// Starts setpoint epoch `epoch` (a replay takes the recorded one): every finger gets a
-    /// SAFE_STOP of it before anything else.
-    pub fn begin_epoch(&mut self, epoch: u16) {
-        self.epochs.begin(epoch);
+    /// Starts setpoint epoch `epoch` for finger `f` (a replay takes the recorded one): the
+    /// finger gets a SAFE_STOP of it before anything else.
+    pub fn begin_epoch(&mut self, f: usize, epoch: u16) {
+        self.epochs.begin(f, epoch);
     }
 
-    /// Starts the next setpoint epoch: the daemon calls it when the bus comes back.
+    /// Starts every finger's next setpoint epoch: the daemon calls it when the bus comes back.
     pub fn new_epoch(&mut self) {
         self.epochs.next();
     }
 
-    /// The setpoint epoch the frames carry now.
-    pub fn epoch(&self) -> u16 {
-        self.epochs.current()
+    /// The setpoint epoch finger `f`'s frames carry now.
+    pub fn epoch(&self, f: usize) -> u16 {
+        self.epochs.current(f)
     }
 
-    /// Setpoint epochs begun since start, the first included.
-    pub fn epochs_begun(&self) -> u64 {
-        self.epochs.begun()
+    /// Every finger's setpoint epoch now.
+    pub fn epochs(&self) -> [u16; N_FINGERS] {
+        self.epochs.all()
+    }
+
+    /// Setpoint epochs finger `f` began since start, the first included.
+    pub fn epochs_begun(&self, f: usize) -> u64 {
+        self.epochs.begun(f)
     }
 
     /// Config, model and bus are validated: BOOT -> READY (SAFE at once without a model).
@@ -255,7 +260,7 @@ impl Engine {
             Command::Arm => self.arm(now_us)?,
             Command::Stop => self.raise(now_us, Fault::StopRequested),
             Command::Calibrating => self.begin_hold(now_us),
-            Command::Swap(m) => self.swap_model(m),
+            Command::Swap(m) => self.swap_model(now_us, m),
         }
         Ok(())
     }
@@ -375,6 +380,10 @@ impl Engine {
     /// Joint angle each finger controller last reported, rad.
     pub fn reported_position(&self) -> &[f64; N_FINGERS] {
         &self.inputs.reported_position
+    }
+    /// What each finger controller last reported that the control law uses (the joint limit).
+    pub fn feedback(&self) -> &[Feedback; N_FINGERS] {
+        &self.inputs.feedback
     }
     /// The amplifier's last lead-off and saturation masks (bit c = channel c).
     pub fn amp_masks(&self) -> (u16, u16) {

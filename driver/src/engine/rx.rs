@@ -11,11 +11,14 @@ use hand_dbc::messages::{
 use hand_dbc::CanFrame;
 
 use super::Engine;
+use crate::conditioner::Feedback;
 use crate::safety::Fault;
 use crate::units::N_FINGERS;
 
 /// FINGER_STATUS fault bit 3 (hand.dbc): the controller braked by itself, setpoint timeout.
 const STATUS_SETPOINT_TIMEOUT: u8 = 1 << 3;
+/// FINGER_STATUS fault bit 5 (hand.dbc): the joint is at a stop and the command pushes into it.
+const STATUS_JOINT_LIMIT: u8 = 1 << 5;
 
 /// The EMG stream: the front end, the signal chain it feeds and what the tick needs to know
 /// about the newest samples.
@@ -124,6 +127,8 @@ pub(super) struct Inputs {
     pub(super) reported_force: [f64; N_FINGERS],
     /// Joint angle each finger controller last reported, rad.
     pub(super) reported_position: [f64; N_FINGERS],
+    /// What each finger controller last reported that the control law uses.
+    pub(super) feedback: [Feedback; N_FINGERS],
     /// The amplifier's last lead-off and saturation masks (bit c = channel c).
     pub(super) amp_masks: (u16, u16),
 }
@@ -141,6 +146,7 @@ impl Inputs {
             amp_reports_bad: false,
             reported_force: [0.0; N_FINGERS],
             reported_position: [0.0; N_FINGERS],
+            feedback: [Feedback::default(); N_FINGERS],
             amp_masks: (0, 0),
         }
     }
@@ -189,8 +195,12 @@ impl Engine {
                         let self_braked = s.state() == FingerState::Braked
                             && s.faults() & STATUS_SETPOINT_TIMEOUT != 0;
                         if self.epochs.on_status(f, self_braked) {
-                            self.epochs.next();
+                            // That finger alone: the others did not retire their epochs.
+                            self.epochs.next_for(f);
                         }
+                        self.inputs.feedback[f] = Feedback {
+                            at_joint_limit: s.faults() & STATUS_JOINT_LIMIT != 0,
+                        };
                     }
                     E2eStatus::Repeated => {}
                     _ => self.counters.e2e_errors += 1,

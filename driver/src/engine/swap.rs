@@ -1,5 +1,14 @@
 //! Models swapped in at a tick boundary, and the calibrating hold.
 //!
+//! One rule for every model change (a deploy, a rollback, `--force` included): the new model
+//! never takes over a moving hand. The swap latches [`Fault::ModelSwapped`]: SAFE at once,
+//! safe stops to every finger (a new epoch, so nothing of the old model's setpoints survives),
+//! every conditioner back to rest, and the hand moves again only after `arm`, when each finger
+//! starts from rest with its gains ramping in. From the patient's side: a new model is a new
+//! map from effort to motion, and the first motion under it should come when the patient and the
+//! technician expect it, not in the middle of a grip at whatever velocity the old model had
+//! wound up. The cost is one `handctl arm` after a deploy, in the technician's presence anyway.
+//!
 //! A deploy prepares the model off the loop (file read, checks, the predictor's buffers all
 //! allocated by the control thread) and hands it over boxed in a [`Command::Swap`]; the tick
 //! that takes the command swaps the predictor and the model id by moving them, and sends the
@@ -81,9 +90,11 @@ impl Engine {
     }
 
     /// Swaps in the model in `m` by moving it (no allocation) and sends the box back with the
-    /// model replaced. A predictor that does not take the chain's features (the control side
-    /// checks this first) is sent back unswapped: its id comes back unchanged.
-    pub(super) fn swap_model(&mut self, mut m: Box<ModelSwap>) {
+    /// model replaced. The hand goes SAFE with [`Fault::ModelSwapped`] latched, every finger
+    /// from rest, until `arm`: see the module docs. A predictor that does not take the chain's
+    /// features (the control side checks this first) is sent back unswapped: its id comes back
+    /// unchanged.
+    pub(super) fn swap_model(&mut self, now_us: u64, mut m: Box<ModelSwap>) {
         let fits = m
             .predictor
             .as_ref()
@@ -95,6 +106,16 @@ impl Engine {
             if self.hold == Hold::Calibrating {
                 self.hold = Hold::Deployed;
             }
+            // The new model never takes over a moving hand: SAFE (safe stops, every finger's
+            // conditioner back to rest) until `arm`. A daemon that had no model never moved
+            // the hand and refused `arm` until now: its first model needs no second `arm`.
+            if m.predictor.is_some() {
+                self.raise(now_us, Fault::ModelSwapped);
+            }
+            for c in &mut self.conditioners {
+                c.reset();
+            }
+            self.labels = [0.0; crate::units::N_FINGERS];
         }
         if let Some(back) = m.back.take() {
             // A sender that gave up waiting has dropped its end: the box is dropped here then.
@@ -155,6 +176,22 @@ mod tests {
         assert_eq!((e.model_id(), e.hold()), (0xabcd, Hold::Deployed));
         e.command(40, Command::Arm).expect("arm after the swap");
         assert!(e.faults().is_empty() && e.hold() == Hold::Free);
+    }
+
+    #[test]
+    fn a_swap_over_a_running_model_latches_safe_until_arm() {
+        let chain = ChainConfig::default().validate().expect("chain");
+        let mut e = Engine::new(&chain, predictor(), EngineSettings::default(), 0);
+        e.validated(0);
+        let (tx, rx) = std::sync::mpsc::sync_channel(1);
+        e.command(30, Command::swap(predictor(), 0xbeef, tx))
+            .expect("swap");
+        assert!(rx.try_recv().expect("back").swapped);
+        assert_eq!(e.state(), DaemonState::Safe);
+        assert!(e.faults().contains(Fault::ModelSwapped), "{:?}", e.faults());
+        assert_eq!(e.labels, [0.0; crate::units::N_FINGERS]);
+        e.command(40, Command::Arm).expect("arm");
+        assert!(!e.faults().contains(Fault::ModelSwapped));
     }
 
     #[test]

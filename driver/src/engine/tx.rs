@@ -66,35 +66,33 @@ fn wrapping_u8(total: u64) -> u8 {
 }
 
 impl Engine {
-    /// The mode of finger `f` when the outputs are off: DISABLED if its controller is silent.
-    fn stopped_mode(&self, f: usize) -> FingerMode {
-        if self.watch.is_disabled(f) {
-            FingerMode::Disabled
-        } else {
-            FingerMode::SafeStop
-        }
-    }
-
-    /// Conditions the labels into setpoints (or stops the fingers) and builds their frames, in
-    /// the current epoch: a finger not yet sent a SAFE_STOP in it gets one first.
+    /// Conditions the labels into setpoints (or stops the fingers) and builds their frames,
+    /// each in its finger's epoch: a finger not yet sent a SAFE_STOP in it gets one first.
+    ///
+    /// A finger that is not driven gets SAFE_STOP (zero force, zero velocity, brake), whether
+    /// the outputs are off or its controller fell silent: never DISABLED, which hand.dbc
+    /// defines as motor off without a brake (a finger that handd cannot hear may still hear it,
+    /// and must brake, not go limp).
     pub(super) fn build_setpoints(&mut self, running: bool) {
         let dt_s = self.settings.tick_us as f64 * 1e-6;
-        let epoch = self.epochs.current();
         for f in 0..N_FINGERS {
             let wanted = if running && !self.watch.is_disabled(f) {
                 FingerMode::Active
             } else {
-                self.stopped_mode(f)
+                FingerMode::SafeStop
             };
             let mode = self.epochs.mode(f, wanted);
             if mode == FingerMode::Active {
                 let gains = &self.settings.gains[f];
-                self.setpoints[f] = self.conditioners[f].step(self.labels[f], gains, dt_s);
+                let feedback = self.inputs.feedback[f];
+                self.setpoints[f] =
+                    self.conditioners[f].step(self.labels[f], gains, dt_s, feedback);
             } else {
                 self.conditioners[f].reset();
                 self.setpoints[f] = Setpoint::default();
             }
-            self.tx.setpoint(f, mode, &self.setpoints[f], epoch);
+            self.tx
+                .setpoint(f, mode, &self.setpoints[f], self.epochs.current(f));
         }
     }
 
@@ -151,7 +149,7 @@ impl Engine {
         self.tx.frames()
     }
 
-    /// Safe-stop setpoints for every finger (DISABLED for a disabled one), E2E-protected, to
+    /// Safe-stop setpoints for every finger, E2E-protected, to
     /// send at once when the bus comes back after a failure rather than at the next tick. Only
     /// when the outputs are not enabled (a bus failure latches SAFE); otherwise nothing, as the
     /// next tick carries the running setpoints. No allocation.

@@ -115,7 +115,8 @@ impl Rig {
     }
 
     /// The first time at or after `from_us` from which every setpoint of `finger` (or of all
-    /// fingers) is a stop (SAFE_STOP or DISABLED with zero force and velocity), until `to_us`.
+    /// fingers) is a stop (SAFE_STOP with zero force and velocity; handd never sends DISABLED),
+    /// until `to_us`.
     pub fn stopped_from(&self, from_us: u64, to_us: u64, finger: Option<usize>) -> Option<u64> {
         let sps: Vec<_> = self
             .setpoints()
@@ -123,7 +124,7 @@ impl Rig {
             .filter(|s| s.0 >= from_us && s.0 <= to_us && finger.is_none_or(|f| s.1 == f))
             .collect();
         let is_stop = |s: &(u64, usize, FingerMode, f64, f64)| {
-            matches!(s.2, FingerMode::SafeStop | FingerMode::Disabled) && s.3 == 0.0 && s.4 == 0.0
+            s.2 == FingerMode::SafeStop && s.3 == 0.0 && s.4 == 0.0
         };
         let last_active = sps.iter().rposition(|s| !is_stop(s));
         match last_active {

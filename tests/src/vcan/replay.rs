@@ -112,11 +112,17 @@ pub fn replay(config: &driver::Config, log: &[LogEntry]) -> ReplayReport {
         phase,
     );
     engine.validated(phase);
-    let first = &log[ticks[0].first].frame;
-    let epoch = FingerSetpoint::decode(first.raw_id(), first.data())
-        .expect("handd's first setpoint decodes")
-        .epoch();
-    engine.begin_epoch(epoch);
+    // Each finger's epoch is its own: each begins at its first recorded setpoint's.
+    for (f, id) in FingerSetpoint::IDS.iter().enumerate() {
+        let first = log[ticks[0].first..]
+            .iter()
+            .find(|e| e.frame.raw_id() == *id)
+            .unwrap_or_else(|| panic!("no setpoint of finger {f} in the log"));
+        let epoch = FingerSetpoint::decode(*id, first.frame.data())
+            .expect("handd's first setpoint decodes")
+            .epoch();
+        engine.begin_epoch(f, epoch);
+    }
     let mut report = ReplayReport {
         same: 0,
         different: Vec::new(),

@@ -50,7 +50,16 @@ fn is_field(field: &str) -> bool {
         "timeouts.recovery_ms",
         "control.socket",
     ];
-    const FINGER: &[&str] = &["kf", "kalpha", "omega_max", "deadband", "slew", "damping"];
+    const FINGER: &[&str] = &[
+        "kf",
+        "kalpha",
+        "omega_max",
+        "deadband",
+        "slew",
+        "damping",
+        "rest_damping",
+        "ramp_s",
+    ];
     TOP.contains(&field)
         || field.strip_prefix("fingers.").is_some_and(|rest| {
             rest.split_once('.')

@@ -130,14 +130,14 @@ fn assert_only_the_hold(seen: &[Seen], t0: u64, t1: u64) {
         .into_iter()
         .filter(|s| s.time_us >= first_cue && s.time_us <= t1)
         .collect();
-    // The hold is SAFE_STOP; a finger whose controller fell silent (handsim starved under
-    // emulation) gets DISABLED, motor off, by the daemon's lost-finger rule: not a motion
-    // either. Nothing ACTIVE or HOLD.
+    // The hold is SAFE_STOP, for a finger whose controller fell silent (handsim starved under
+    // emulation) too: handd never sends DISABLED (motor off, the finger would coast). Nothing
+    // ACTIVE, HOLD or DISABLED.
     let count = |m: FingerMode| during.iter().filter(|s| s.mode == m).count();
     let (stop, disabled) = (count(FingerMode::SafeStop), count(FingerMode::Disabled));
     println!(
-        "while calibrating: {} setpoints, {stop} SAFE_STOP, {disabled} DISABLED (a silent \
-         controller), {} ACTIVE, {} HOLD",
+        "while calibrating: {} setpoints, {stop} SAFE_STOP, {disabled} DISABLED, {} ACTIVE, \
+         {} HOLD",
         during.len(),
         count(FingerMode::Active),
         count(FingerMode::Hold)
@@ -147,8 +147,9 @@ fn assert_only_the_hold(seen: &[Seen], t0: u64, t1: u64) {
         "only {} setpoints while calibrating: is handd sending?",
         during.len()
     );
+    assert_eq!(disabled, 0, "handd sent DISABLED while calibrating");
     assert_eq!(
-        stop + disabled,
+        stop,
         during.len(),
         "setpoints other than the hold while calibrating"
     );
