@@ -3037,7 +3037,7 @@ impl FingerSetpoint {
         Ok(())
     }
 
-    /// `Mode` (enum): DISABLED: motor off; ACTIVE: follow force and velocity; HOLD: keep position; SAFE_STOP: zero force, zero velocity, brake.
+    /// `Mode` (enum): DISABLED: motor off, no brake, the finger is free (handd never sends it: every stop of handd's, a finger it lost included, is SAFE_STOP); ACTIVE: follow Force and Velocity (rule at Velocity); HOLD: keep position; SAFE_STOP: zero force, zero velocity, brake. On HAND_ESTOP STOP the controller brakes and retires its epoch: RELEASE does not resume anything, the finger moves again only after a SAFE_STOP of a new epoch (rule at Epoch).
     pub fn mode(&self) -> FingerMode {
         self.mode
     }
@@ -3047,7 +3047,7 @@ impl FingerSetpoint {
         self.mode = value;
     }
 
-    /// `Force` (N): Force setpoint, flexion positive. handd sends 0 in SAFE_STOP.
+    /// `Force` (N): The most force the finger may push with at the fingertip, flexion positive; its sign must agree with Velocity's for the finger to move (rule at Velocity). handd sends 0 in SAFE_STOP.
     pub fn force(&self) -> f64 {
         f64::from(self.force) * 0.01
     }
@@ -3100,7 +3100,7 @@ impl FingerSetpoint {
         Ok(())
     }
 
-    /// `Velocity` (rad/s): Joint velocity setpoint, flexion positive.
+    /// `Velocity` (rad/s): Commanded joint velocity, flexion positive. In ACTIVE the controller drives the joint at Velocity, pushing with at most |Force|, when Force and Velocity are both non-zero and of the same sign; when they differ in sign, or either is zero, it holds the finger still (as HOLD). A finger blocked by an object or by its joint stop pushes with at most |Force|. A controller that cannot reach Velocity or |Force| within its own limits saturates and reports it (it never exceeds them).
     pub fn velocity(&self) -> f64 {
         f64::from(self.velocity) * 0.001
     }
@@ -3156,7 +3156,7 @@ impl FingerSetpoint {
         Ok(())
     }
 
-    /// `Epoch` (epoch): Setpoint epoch. handd draws a fresh, unpredictable epoch at every start and takes the next one (+1 modulo 65536) on every bus recovery (reopen after bus-off or link down), every change of state into SAFE and every report of a controller that braked by itself; in each epoch it sends a finger SAFE_STOP before anything else. The controller is bound to at most one epoch and remembers the last one it left (retired). A valid SAFE_STOP of an epoch that is not retired binds the controller to it (retiring the previous one); every other setpoint (ACTIVE, HOLD, DISABLED) is followed only if its epoch is the bound one, and a setpoint of the retired epoch, or of any epoch but the bound one, is ignored and counted. At power-up the controller is bound to none; when it brakes by itself (no valid setpoint for 150 ms) it retires its epoch and is bound to none, so it moves again only after a SAFE_STOP of a new epoch. Epochs are compared for equality only, so the counter wraps freely; within one run of handd an epoch repeats only after 65536 changes.
+    /// `Epoch` (epoch): Setpoint epoch, one per finger. handd draws a fresh, unpredictable epoch for each finger at every start and moves every finger to its next one (+1 modulo 65536) on every bus recovery (reopen after bus-off or link down) and every change of state into SAFE, but only finger f on a report of finger f's controller that it braked by itself (the others keep their epoch and their force); in each of its epochs a finger gets SAFE_STOP before anything else. The controller is bound to at most one epoch and remembers the last one it left (retired). A valid SAFE_STOP of an epoch that is not retired binds the controller to it (retiring the previous one); every other setpoint (ACTIVE, HOLD, DISABLED) is followed only if its epoch is the bound one, and a setpoint of the retired epoch, or of any epoch but the bound one, is ignored and counted. At power-up the controller is bound to none; when it brakes by itself (no valid setpoint for 150 ms) or on HAND_ESTOP STOP it retires its epoch and is bound to none, so it moves again only after a SAFE_STOP of a new epoch. Epochs are compared for equality only, so the counter wraps freely; within one run of handd an epoch repeats only after 65536 changes.
     pub fn epoch(&self) -> u16 {
         self.epoch
     }
@@ -3720,7 +3720,7 @@ impl FingerStatus {
         Ok(())
     }
 
-    /// `Faults` (bitmask): bit 0 over-current, bit 1 over-temperature, bit 2 encoder, bit 3 setpoint timeout (braked), bit 4 E2E error on setpoints, bit 5 joint limit, bit 6 setpoint ignored by the epoch rule (a valid setpoint of a stale or not yet opened epoch, see FINGER_SETPOINT Epoch) since the previous status.
+    /// `Faults` (bitmask): bit 0 over-current, bit 1 over-temperature, bit 2 encoder, bit 3 setpoint timeout (braked), bit 4 E2E error on setpoints, bit 5 joint limit (at a joint stop with the command pushing into it: handd stops integrating velocity toward that stop), bit 6 setpoint ignored by the epoch rule (a valid setpoint of a stale or not yet opened epoch, see FINGER_SETPOINT Epoch) since the previous status.
     pub fn faults(&self) -> u8 {
         self.faults
     }
@@ -4058,7 +4058,7 @@ impl HandHeartbeat {
         self.state = value;
     }
 
-    /// `FaultMask` (bitmask): handd's active faults, one bit each, as handctl status names them: bit 0 emg_silence, bit 1 e2e_error, bit 2 invalid_window, bit 3 non_finite, bit 4 signal_quality, bit 5 estop, bit 6 bus_off, bit 7 interface_down, bit 8 repeated_e2e, bit 9 model_error, bit 10 stop_requested, bit 11 calibrating, bit 12 no_model; bits 13..15 unused. A finger whose controller fell silent is not a daemon fault: FINGER_STATUS and handctl status show it.
+    /// `FaultMask` (bitmask): handd's active faults, one bit each, as handctl status names them: bit 0 emg_silence, bit 1 e2e_error, bit 2 invalid_window, bit 3 non_finite, bit 4 signal_quality, bit 5 estop, bit 6 bus_off, bit 7 interface_down, bit 8 repeated_e2e, bit 9 model_error, bit 10 stop_requested, bit 11 calibrating, bit 12 no_model, bit 13 model_swapped; bits 14..15 unused. A finger whose controller fell silent is not a daemon fault: FINGER_STATUS and handctl status show it.
     pub fn fault_mask(&self) -> u16 {
         self.fault_mask
     }
@@ -5767,10 +5767,10 @@ pub const MESSAGES: &[MessageInfo] = &[
         signals: &[
             SignalInfo { name: "Crc", start_bit: 0, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "crc", values: &[], comment: "" },
             SignalInfo { name: "Counter", start_bit: 8, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 15.0, raw_min: 0, raw_max: 15, unit: "count", values: &[], comment: "" },
-            SignalInfo { name: "Mode", start_bit: 12, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 3.0, raw_min: 0, raw_max: 3, unit: "enum", values: &[(0, "DISABLED"), (1, "ACTIVE"), (2, "HOLD"), (3, "SAFE_STOP")], comment: "DISABLED: motor off; ACTIVE: follow force and velocity; HOLD: keep position; SAFE_STOP: zero force, zero velocity, brake." },
-            SignalInfo { name: "Force", start_bit: 16, size: 16, signed: true, factor: 0.01, offset: 0.0, min: -50.0, max: 50.0, raw_min: -5000, raw_max: 5000, unit: "N", values: &[], comment: "Force setpoint, flexion positive. handd sends 0 in SAFE_STOP." },
-            SignalInfo { name: "Velocity", start_bit: 32, size: 16, signed: true, factor: 0.001, offset: 0.0, min: -20.0, max: 20.0, raw_min: -20000, raw_max: 20000, unit: "rad/s", values: &[], comment: "Joint velocity setpoint, flexion positive." },
-            SignalInfo { name: "Epoch", start_bit: 48, size: 16, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 65535.0, raw_min: 0, raw_max: 65535, unit: "epoch", values: &[], comment: "Setpoint epoch. handd draws a fresh, unpredictable epoch at every start and takes the next one (+1 modulo 65536) on every bus recovery (reopen after bus-off or link down), every change of state into SAFE and every report of a controller that braked by itself; in each epoch it sends a finger SAFE_STOP before anything else. The controller is bound to at most one epoch and remembers the last one it left (retired). A valid SAFE_STOP of an epoch that is not retired binds the controller to it (retiring the previous one); every other setpoint (ACTIVE, HOLD, DISABLED) is followed only if its epoch is the bound one, and a setpoint of the retired epoch, or of any epoch but the bound one, is ignored and counted. At power-up the controller is bound to none; when it brakes by itself (no valid setpoint for 150 ms) it retires its epoch and is bound to none, so it moves again only after a SAFE_STOP of a new epoch. Epochs are compared for equality only, so the counter wraps freely; within one run of handd an epoch repeats only after 65536 changes." },
+            SignalInfo { name: "Mode", start_bit: 12, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 3.0, raw_min: 0, raw_max: 3, unit: "enum", values: &[(0, "DISABLED"), (1, "ACTIVE"), (2, "HOLD"), (3, "SAFE_STOP")], comment: "DISABLED: motor off, no brake, the finger is free (handd never sends it: every stop of handd's, a finger it lost included, is SAFE_STOP); ACTIVE: follow Force and Velocity (rule at Velocity); HOLD: keep position; SAFE_STOP: zero force, zero velocity, brake. On HAND_ESTOP STOP the controller brakes and retires its epoch: RELEASE does not resume anything, the finger moves again only after a SAFE_STOP of a new epoch (rule at Epoch)." },
+            SignalInfo { name: "Force", start_bit: 16, size: 16, signed: true, factor: 0.01, offset: 0.0, min: -50.0, max: 50.0, raw_min: -5000, raw_max: 5000, unit: "N", values: &[], comment: "The most force the finger may push with at the fingertip, flexion positive; its sign must agree with Velocity's for the finger to move (rule at Velocity). handd sends 0 in SAFE_STOP." },
+            SignalInfo { name: "Velocity", start_bit: 32, size: 16, signed: true, factor: 0.001, offset: 0.0, min: -20.0, max: 20.0, raw_min: -20000, raw_max: 20000, unit: "rad/s", values: &[], comment: "Commanded joint velocity, flexion positive. In ACTIVE the controller drives the joint at Velocity, pushing with at most |Force|, when Force and Velocity are both non-zero and of the same sign; when they differ in sign, or either is zero, it holds the finger still (as HOLD). A finger blocked by an object or by its joint stop pushes with at most |Force|. A controller that cannot reach Velocity or |Force| within its own limits saturates and reports it (it never exceeds them)." },
+            SignalInfo { name: "Epoch", start_bit: 48, size: 16, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 65535.0, raw_min: 0, raw_max: 65535, unit: "epoch", values: &[], comment: "Setpoint epoch, one per finger. handd draws a fresh, unpredictable epoch for each finger at every start and moves every finger to its next one (+1 modulo 65536) on every bus recovery (reopen after bus-off or link down) and every change of state into SAFE, but only finger f on a report of finger f's controller that it braked by itself (the others keep their epoch and their force); in each of its epochs a finger gets SAFE_STOP before anything else. The controller is bound to at most one epoch and remembers the last one it left (retired). A valid SAFE_STOP of an epoch that is not retired binds the controller to it (retiring the previous one); every other setpoint (ACTIVE, HOLD, DISABLED) is followed only if its epoch is the bound one, and a setpoint of the retired epoch, or of any epoch but the bound one, is ignored and counted. At power-up the controller is bound to none; when it brakes by itself (no valid setpoint for 150 ms) or on HAND_ESTOP STOP it retires its epoch and is bound to none, so it moves again only after a SAFE_STOP of a new epoch. Epochs are compared for equality only, so the counter wraps freely; within one run of handd an epoch repeats only after 65536 changes." },
         ],
     },
     MessageInfo {
@@ -5861,7 +5861,7 @@ pub const MESSAGES: &[MessageInfo] = &[
             SignalInfo { name: "Position", start_bit: 16, size: 12, signed: false, factor: 0.001, offset: -0.5, min: -0.5, max: 2.0, raw_min: 0, raw_max: 2500, unit: "rad", values: &[], comment: "Joint angle, 0 = fully extended, flexion positive." },
             SignalInfo { name: "Velocity", start_bit: 28, size: 12, signed: true, factor: 0.01, offset: 0.0, min: -20.0, max: 20.0, raw_min: -2000, raw_max: 2000, unit: "rad/s", values: &[], comment: "" },
             SignalInfo { name: "Force", start_bit: 40, size: 12, signed: true, factor: 0.025, offset: 0.0, min: -50.0, max: 50.0, raw_min: -2000, raw_max: 2000, unit: "N", values: &[], comment: "" },
-            SignalInfo { name: "Faults", start_bit: 52, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "bitmask", values: &[], comment: "bit 0 over-current, bit 1 over-temperature, bit 2 encoder, bit 3 setpoint timeout (braked), bit 4 E2E error on setpoints, bit 5 joint limit, bit 6 setpoint ignored by the epoch rule (a valid setpoint of a stale or not yet opened epoch, see FINGER_SETPOINT Epoch) since the previous status." },
+            SignalInfo { name: "Faults", start_bit: 52, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "bitmask", values: &[], comment: "bit 0 over-current, bit 1 over-temperature, bit 2 encoder, bit 3 setpoint timeout (braked), bit 4 E2E error on setpoints, bit 5 joint limit (at a joint stop with the command pushing into it: handd stops integrating velocity toward that stop), bit 6 setpoint ignored by the epoch rule (a valid setpoint of a stale or not yet opened epoch, see FINGER_SETPOINT Epoch) since the previous status." },
         ],
     },
     MessageInfo {
@@ -5953,7 +5953,7 @@ pub const MESSAGES: &[MessageInfo] = &[
             SignalInfo { name: "Crc", start_bit: 0, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "crc", values: &[], comment: "" },
             SignalInfo { name: "Counter", start_bit: 8, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 15.0, raw_min: 0, raw_max: 15, unit: "count", values: &[], comment: "" },
             SignalInfo { name: "State", start_bit: 12, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 3.0, raw_min: 0, raw_max: 3, unit: "enum", values: &[(0, "BOOT"), (1, "READY"), (2, "RUNNING"), (3, "SAFE")], comment: "" },
-            SignalInfo { name: "FaultMask", start_bit: 16, size: 16, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 65535.0, raw_min: 0, raw_max: 65535, unit: "bitmask", values: &[], comment: "handd's active faults, one bit each, as handctl status names them: bit 0 emg_silence, bit 1 e2e_error, bit 2 invalid_window, bit 3 non_finite, bit 4 signal_quality, bit 5 estop, bit 6 bus_off, bit 7 interface_down, bit 8 repeated_e2e, bit 9 model_error, bit 10 stop_requested, bit 11 calibrating, bit 12 no_model; bits 13..15 unused. A finger whose controller fell silent is not a daemon fault: FINGER_STATUS and handctl status show it." },
+            SignalInfo { name: "FaultMask", start_bit: 16, size: 16, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 65535.0, raw_min: 0, raw_max: 65535, unit: "bitmask", values: &[], comment: "handd's active faults, one bit each, as handctl status names them: bit 0 emg_silence, bit 1 e2e_error, bit 2 invalid_window, bit 3 non_finite, bit 4 signal_quality, bit 5 estop, bit 6 bus_off, bit 7 interface_down, bit 8 repeated_e2e, bit 9 model_error, bit 10 stop_requested, bit 11 calibrating, bit 12 no_model, bit 13 model_swapped; bits 14..15 unused. A finger whose controller fell silent is not a daemon fault: FINGER_STATUS and handctl status show it." },
             SignalInfo { name: "ModelId", start_bit: 32, size: 32, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 4294967295.0, raw_min: 0, raw_max: 4294967295, unit: "id", values: &[], comment: "First 4 bytes (little-endian) of the loaded model file's checksum; 0 when no model is loaded." },
         ],
     },

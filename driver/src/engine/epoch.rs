@@ -8,7 +8,7 @@
 //! when finger f's controller reports that it braked by itself (FINGER_STATUS BRAKED with the
 //! setpoint-timeout bit, on the report's rising edge): that controller retired its epoch, the
 //! others did not, and they keep their force. In each of its epochs a finger gets a SAFE_STOP
-//! before anything else (DISABLED included): the controller opens an epoch only on a SAFE_STOP,
+//! before anything else: the controller opens an epoch only on a SAFE_STOP,
 //! and ignores every setpoint of another epoch, so frames of an older epoch still queued in the
 //! kernel or in a CAN controller's mailboxes cannot move the finger once the new epoch's
 //! SAFE_STOP has reached it.
