@@ -23,7 +23,7 @@ use decoder::model::{
 use decoder::session::{check_gates, GateConfig, LabelledWindows, Session, WindowOptions};
 use hand_clock::{Clock, SystemClock, VirtualClock};
 use hand_dbc::candump::LogWriter;
-use hand_dbc::messages::FingerStatus;
+use hand_dbc::messages::{FingerSetpoint, FingerStatus};
 use hand_dbc::CanFrame;
 use hand_model::emg::AmplifierConfig;
 use hand_model::nodes::AmplifierNodeConfig;
@@ -34,7 +34,7 @@ use hand_model::{MemBus, MemEndpoint, Scenario};
 
 use crate::config::Config;
 use crate::daemon::{Runner, Snapshot};
-use crate::engine::Engine;
+use crate::engine::{Command, Engine};
 use crate::mem_transport::MemTransport;
 use crate::startup::engine_settings;
 
@@ -58,6 +58,18 @@ pub struct DemoOptions {
     /// The paper's labels: the fingers a single-finger trial does not move are masked out of
     /// the loss instead of trained toward 0.
     pub mask_others: bool,
+    /// The output law of the tracking phase: the shipped one, or the paper's pure integrator.
+    pub law: OutputLaw,
+}
+
+/// Which velocity law the tracking phase's conditioners run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum OutputLaw {
+    /// The shipped defaults: ω decays at rest and while driven (no wind-up).
+    #[default]
+    Shipped,
+    /// The paper's law: `ω = ω0 + α·t`, held at rest ([`crate::conditioner::FingerGains::paper_law`]).
+    Paper,
 }
 
 impl Default for DemoOptions {
@@ -71,6 +83,7 @@ impl Default for DemoOptions {
             max_epochs: 200,
             plain: false,
             mask_others: false,
+            law: OutputLaw::Shipped,
         }
     }
 }
@@ -102,6 +115,13 @@ pub struct DemoReport {
     /// the scored samples, while only the index finger moves (the other fingers should stay
     /// near 0).
     pub mean_abs_label: [f64; N_FINGERS],
+    /// Per finger, the mean |velocity setpoint| handd sent over the scored time, rad/s: what
+    /// the output law makes of the labels (the fingers the patient does not move should stay
+    /// near 0).
+    pub mean_abs_velocity: [f64; N_FINGERS],
+    /// Per finger, the time its controller reported being at a joint stop with the command
+    /// pushing into it (FINGER_STATUS fault bit 5) over the scored time, s.
+    pub at_stop_s: [f64; N_FINGERS],
     /// The daemon's snapshot at the end (latency, deadline misses, ...).
     pub end: Snapshot,
 }
@@ -260,7 +280,7 @@ pub fn run_demo(
     on(DemoEvent::Phase(
         "tracking: the daemon drives the hand, the patient follows a sine with the index finger",
     ));
-    let (samples, end) = if opts.fast {
+    let (Tracked { samples, motion }, end) = if opts.fast {
         track(&model, opts, VirtualClock::new(), true, &mut on)?
     } else {
         track(&model, opts, SystemClock::new(), false, &mut on)?
@@ -286,6 +306,10 @@ pub fn run_demo(
         mape: m.mape,
         r2: m.r2,
         mean_abs_label,
+        mean_abs_velocity: std::array::from_fn(|f| {
+            motion.abs_velocity[f] / motion.setpoints.max(1) as f64
+        }),
+        at_stop_s: motion.at_stop_s,
         end,
     })
 }
@@ -409,14 +433,35 @@ struct TrackSample {
     labels: [f64; N_FINGERS],
 }
 
-/// Runs the closed loop; returns a sample at every index FINGER_STATUS.
+/// What every finger did over the scored time.
+#[derive(Debug, Default)]
+struct Motion {
+    /// Setpoint rounds (ticks) seen.
+    setpoints: usize,
+    /// Sum of |velocity setpoint| per finger.
+    abs_velocity: [f64; N_FINGERS],
+    /// Seconds at a joint stop per finger (FINGER_STATUS bit 5, one status period each).
+    at_stop_s: [f64; N_FINGERS],
+}
+
+/// The tracking phase's record.
+struct Tracked {
+    samples: Vec<TrackSample>,
+    motion: Motion,
+}
+
+/// FINGER_STATUS fault bit 5: at a joint stop, the command pushing into it.
+const STATUS_JOINT_LIMIT: u8 = 1 << 5;
+
+/// Runs the closed loop; returns a sample at every index FINGER_STATUS and every finger's
+/// motion after the settling time.
 fn track<K: DemoClock>(
     model: &TrainedModel,
     opts: &DemoOptions,
     clock: K,
     virtual_time: bool,
     on: &mut impl FnMut(DemoEvent<'_>),
-) -> Result<(Vec<TrackSample>, Snapshot), DemoError> {
+) -> Result<(Tracked, Snapshot), DemoError> {
     let ClosedLoop {
         mut world,
         mut runner,
@@ -424,6 +469,18 @@ fn track<K: DemoClock>(
         start_us: start,
         tracking,
     } = closed_loop(model, opts.seed, clock.clone())?;
+    if opts.law == OutputLaw::Paper {
+        for f in 0..N_FINGERS {
+            let g = runner.engine().gains()[f].paper_law();
+            runner
+                .engine_mut()
+                .command(start, Command::SetGains(f, g))
+                .map_err(|e| DemoError::Gates(format!("the paper's law: {e}")))?;
+        }
+    }
+    let scored_from = start + (opts.settle_s * 1e6) as u64;
+    let status_period_s = 0.02;
+    let mut motion = Motion::default();
     let mut probe = bus.endpoint();
     let end = start + (opts.track_s * 1e6) as u64;
     let mut samples = Vec::new();
@@ -446,6 +503,22 @@ fn track<K: DemoClock>(
         }
         while let Some(r) = probe.receive_timestamped() {
             let id = r.frame.raw_id();
+            let at = r.time_us.unwrap_or(now);
+            if at >= scored_from {
+                if let Some(f) = FingerSetpoint::instance_of(id) {
+                    if let Ok(sp) = FingerSetpoint::decode(id, r.frame.data()) {
+                        motion.abs_velocity[f] += sp.velocity().abs();
+                        motion.setpoints += usize::from(f == 0);
+                    }
+                }
+                if let Some(f) = FingerStatus::instance_of(id) {
+                    if let Ok(st) = FingerStatus::decode(id, r.frame.data()) {
+                        if st.faults() & STATUS_JOINT_LIMIT != 0 {
+                            motion.at_stop_s[f] += status_period_s;
+                        }
+                    }
+                }
+            }
             if FingerStatus::instance_of(id) == Some(tracking.finger) {
                 if let Ok(st) = FingerStatus::decode(id, r.frame.data()) {
                     let t = r.time_us.unwrap_or(now).saturating_sub(start);
@@ -472,5 +545,5 @@ fn track<K: DemoClock>(
         }
     }
     let snap = *runner.snapshot().lock().unwrap_or_else(|e| e.into_inner());
-    Ok((samples, snap))
+    Ok((Tracked { samples, motion }, snap))
 }

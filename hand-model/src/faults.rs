@@ -72,6 +72,13 @@ pub enum Fault {
         /// The silent finger.
         finger: usize,
     },
+    /// A motor controller receives no setpoints (its receive path broke; the bus and the
+    /// other controllers are fine): it brakes by itself after its setpoint timeout and reports
+    /// it, while the other fingers go on.
+    SetpointLoss {
+        /// The finger whose controller hears nothing.
+        finger: usize,
+    },
     /// `count` frames with an id hand.dbc does not define, sent at once when the fault starts.
     UnknownIdBurst {
         /// 11-bit id not in hand.dbc.
@@ -111,6 +118,7 @@ impl Fault {
                 ..
             }
             | Fault::MotorSilent { finger: f }
+            | Fault::SetpointLoss { finger: f }
                 if f >= N_FINGERS =>
             {
                 Err(SimError::BadFinger(f))
@@ -137,7 +145,7 @@ impl Fault {
     pub const SYNTAX: &'static str =
         "drop-emg[:N] repeat-emg[:N] reorder-emg[:N] counter-jump[:BY] \
 bad-crc-emg[:N] bad-crc-status[:N] bad-crc-finger:F[:N] lead-off[:MASK] saturation[:MASK] \
-amp-silence estop motor-silent:F unknown-ids[:ID[:COUNT]] flood";
+amp-silence estop motor-silent:F setpoint-loss:F unknown-ids[:ID[:COUNT]] flood";
 }
 
 fn num<T: FromStr>(s: Option<&str>, default: T, what: &str) -> Result<T, SimError> {
@@ -195,6 +203,9 @@ impl FromStr for Fault {
             "amp-silence" => Fault::AmplifierSilence,
             "estop" => Fault::EStop,
             "motor-silent" => Fault::MotorSilent {
+                finger: num(a, usize::MAX, s)?,
+            },
+            "setpoint-loss" => Fault::SetpointLoss {
                 finger: num(a, usize::MAX, s)?,
             },
             "unknown-ids" => Fault::UnknownIdBurst {

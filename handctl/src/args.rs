@@ -206,6 +206,19 @@ pub struct DemoArgs {
     /// The paper's labels: fingers a single-finger trial does not move are left out of the loss.
     #[arg(long)]
     pub paper_masks: bool,
+    /// The output law while tracking: `shipped` (ω decays at rest, no wind-up) or `paper`
+    /// (the paper's `ω = ω0 + α·t`, held at rest), to compare the two.
+    #[arg(long, value_enum, default_value_t = DemoLaw::Shipped)]
+    pub law: DemoLaw,
+}
+
+/// `handctl demo --law`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DemoLaw {
+    /// The shipped defaults (damping, rest damping, gain ramp).
+    Shipped,
+    /// The paper's pure integrator.
+    Paper,
 }
 
 fn parse_seconds(s: &str) -> Result<f64, String> {

@@ -4,10 +4,10 @@
 
 use std::io::{IsTerminal, Write};
 
-use driver::demo::{run_demo, DemoEvent, DemoOptions};
+use driver::demo::{run_demo, DemoEvent, DemoOptions, OutputLaw};
 use driver::units::FINGER_NAMES;
 
-use super::args::DemoArgs;
+use super::args::{DemoArgs, DemoLaw};
 use super::error::CliError;
 use super::progress::Progress;
 
@@ -24,6 +24,10 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
             .unwrap_or_else(|| std::env::temp_dir().join("handstack-demo")),
         plain: a.plain,
         mask_others: a.paper_masks,
+        law: match a.law {
+            DemoLaw::Shipped => OutputLaw::Shipped,
+            DemoLaw::Paper => OutputLaw::Paper,
+        },
         ..DemoOptions::default()
     };
     let tty = std::io::stdout().is_terminal();
@@ -91,6 +95,11 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
     );
     println!("{}", selectivity(&report.mean_abs_label));
     println!(
+        "output law {:?}: {}",
+        a.law,
+        motion(&report.mean_abs_velocity, &report.at_stop_s)
+    );
+    println!(
         "daemon: latency p50 {} us p99 {} us, compute p50 {} us p99 {} us, deadline misses {}, state {}",
         report.end.latency.p50_us,
         report.end.latency.p99_us,
@@ -109,6 +118,22 @@ fn selectivity(mean_abs_label: &[f64; 5]) -> String {
         .collect();
     format!(
         "selectivity (mean |label| per finger while the index tracks; others should stay near 0): {}",
+        fingers.join(", ")
+    )
+}
+
+/// The output law's line: per finger, the mean |velocity setpoint| and the time at a joint stop.
+fn motion(mean_abs_velocity: &[f64; 5], at_stop_s: &[f64; 5]) -> String {
+    let fingers: Vec<String> = (0..5)
+        .map(|f| {
+            format!(
+                "{} {:.2} rad/s, {:.1} s",
+                FINGER_NAMES[f], mean_abs_velocity[f], at_stop_s[f]
+            )
+        })
+        .collect();
+    format!(
+        "mean |velocity setpoint| and time at a joint stop per finger: {}",
         fingers.join(", ")
     )
 }

@@ -91,8 +91,12 @@ impl Epochs {
     /// The mode to send finger `f` when the engine wants `wanted`: a SAFE_STOP in place of
     /// anything else until the finger got one in its epoch. DISABLED too: a controller that
     /// handd cannot hear may still hear handd, and it must leave its old epoch.
+    /// And SAFE_STOP again while the finger's last status says it braked by itself: the
+    /// SAFE_STOP that opened the epoch may have been lost on the way (the controller then stays
+    /// braked and ignores everything else), so it is repeated until the controller reports
+    /// that it took it.
     pub(super) fn mode(&mut self, f: usize, wanted: FingerMode) -> FingerMode {
-        if self.opened[f] {
+        if self.opened[f] && !self.self_braked[f] {
             return wanted;
         }
         self.opened[f] = true;
@@ -173,6 +177,20 @@ mod tests {
         }
         assert_eq!(e.mode(2, Active), SafeStop, "only finger 2 is reopened");
         assert_eq!(e.mode(2, Active), Active);
+    }
+
+    #[test]
+    fn a_finger_that_still_reports_its_self_brake_keeps_getting_safe_stops() {
+        let mut e = Epochs::new([7; N_FINGERS]);
+        assert!(e.on_status(4, true));
+        e.next_for(4);
+        // The opening SAFE_STOP was lost: the controller still reports its self-brake.
+        assert_eq!(e.mode(4, Active), SafeStop);
+        assert!(!e.on_status(4, true));
+        assert_eq!(e.mode(4, Active), SafeStop, "repeated while braked");
+        // It took one: SAFE_STOP state, no longer braked by itself.
+        assert!(!e.on_status(4, false));
+        assert_eq!(e.mode(4, Active), Active);
     }
 
     #[test]

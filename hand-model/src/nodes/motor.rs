@@ -148,7 +148,14 @@ impl FingerNode {
 
     /// Reads setpoints and E-stops, runs the control loop up to `now_us`, sends status.
     pub fn poll<B: Bus>(&mut self, now_us: u64, bus: &mut B) {
+        let deaf = self
+            .faults
+            .active(now_us)
+            .any(|(_, f)| matches!(f, Fault::SetpointLoss { finger } if finger == self.finger));
         while let Some(frame) = self.stats.receive(bus) {
+            if deaf && std_id(&frame) == FingerSetpoint::IDS[self.finger] {
+                continue;
+            }
             self.on_frame(now_us, &frame);
         }
         let dt_us = self.cfg.control_period_us;
