@@ -19,7 +19,7 @@ use crate::conditioner::{FingerGains, Setpoint};
 use crate::engine::{Command, Counters, Engine};
 use crate::safety::{DaemonState, Fault, FaultSet, FingerEvent};
 use crate::stats::Percentiles;
-use crate::transport::{Transport, TransportError};
+use crate::transport::{BusHealth, ControllerState, Transport, TransportError};
 use crate::units::{FINGER_NAMES, N_FINGERS};
 
 /// EMG channels a snapshot holds (the bus's).
@@ -76,6 +76,8 @@ pub struct Snapshot {
     /// Ticks whose snapshot was not published because a reader held it (the tick never
     /// waits for one): a measure of reader contention.
     pub publish_skips: u64,
+    /// The CAN controller's error state and every bus error class, counted.
+    pub bus: BusHealth,
 }
 
 impl Default for Snapshot {
@@ -104,6 +106,7 @@ impl Default for Snapshot {
             frames_tx: 0,
             bus_load: 0.0,
             publish_skips: 0,
+            bus: BusHealth::default(),
         }
     }
 }
@@ -116,10 +119,41 @@ pub type SharedSnapshot = Arc<Mutex<Snapshot>>;
 /// control side's queue is bounded too, so a flood of commands cannot lengthen a tick).
 pub const MAX_COMMANDS_PER_TICK: usize = 8;
 
-/// First and longest wait between attempts to reopen a failed bus, µs. Short, because the
-/// first frames after a reopen are the safe stops the finger controllers need within 100 ms;
-/// capped at one 50 ms tick, because a failed attempt costs only a check of the interface.
-pub const REOPEN_BACKOFF_US: (u64, u64) = (10_000, 50_000);
+/// First and longest wait between attempts to reopen a failed bus, µs. Short at first, because
+/// the first frames after a reopen are the safe stops the finger controllers need within
+/// 100 ms. It doubles after every failure, a reopen that is followed by a failure before the
+/// bus carried a frame included (a controller still bus-off, or no one to ACK): such a loop
+/// would otherwise spin, logging and starting a new setpoint epoch every 10 ms. It resets once
+/// the bus has taken a frame of ours again (the safe stops sent at the reopen do not count:
+/// the first of them is what fails on a controller that is still bus-off).
+pub const REOPEN_BACKOFF_US: (u64, u64) = (10_000, 1_000_000);
+
+/// A transmit queue that stays full this long raises [`Fault::BusDegraded`], µs: the finger
+/// controllers brake by themselves after 150 ms without a setpoint anyway.
+pub const QUEUE_FULL_FAULT_US: u64 = 150_000;
+
+/// Repeated bus log lines (a failure, a reopen) are written at most once per this time, µs,
+/// with the count of the ones left out: the log goes to an SD card, from the real-time loop.
+pub const BUS_LOG_EVERY_US: u64 = 10_000_000;
+
+/// Rate limit of a repeated log line.
+#[derive(Debug, Clone, Copy, Default)]
+struct LogLimit {
+    last_us: Option<u64>,
+    suppressed: u64,
+}
+
+impl LogLimit {
+    /// `Some(left out since the last line)` when a line may be written now.
+    fn allow(&mut self, now_us: u64) -> Option<u64> {
+        if self.last_us.is_some_and(|l| now_us < l + BUS_LOG_EVERY_US) {
+            self.suppressed += 1;
+            return None;
+        }
+        self.last_us = Some(now_us);
+        Some(std::mem::take(&mut self.suppressed))
+    }
+}
 
 /// The loop.
 pub struct Runner<T: Transport, K: Clock> {
@@ -140,6 +174,16 @@ pub struct Runner<T: Transport, K: Clock> {
     frames_tx: u64,
     bus_load: BusLoad,
     publish_skips: u64,
+    /// Since when sends have been refused with a full queue (none since).
+    queue_full_since: Option<u64>,
+    /// Frames the transmit queue refused.
+    tx_queue_full: u64,
+    /// Reopen attempts that failed.
+    reopen_failures: u64,
+    /// A tick's frames were all taken since the last reopen (the bus carries our frames).
+    carried: bool,
+    failure_log: LogLimit,
+    reopen_log: LogLimit,
 }
 
 impl<T: Transport, K: Clock> Runner<T, K> {
@@ -163,6 +207,12 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             frames_tx: 0,
             bus_load: BusLoad::new(tick_us),
             publish_skips: 0,
+            queue_full_since: None,
+            tx_queue_full: 0,
+            reopen_failures: 0,
+            carried: true,
+            failure_log: LogLimit::default(),
+            reopen_log: LogLimit::default(),
         }
     }
 
@@ -207,21 +257,52 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         self.last_tick_on_time
     }
 
+    /// The bus's health with the daemon's own counts.
+    pub fn bus_health(&self) -> BusHealth {
+        let mut h = self.transport.health();
+        h.counters.tx_queue_full = self.tx_queue_full;
+        h.counters.reopen_failures = self.reopen_failures;
+        h
+    }
+
     fn bus_failed(&mut self, now_us: u64, e: &TransportError) {
         let fault = match e {
-            TransportError::BusOff | TransportError::ErrorPassive => Fault::BusOff,
+            TransportError::BusOff => Fault::BusOff,
             _ => Fault::InterfaceDown,
         };
         if self.bus_ok {
-            tracing::error!(error = %e, "bus failed: sending stops, queued setpoints dropped");
+            if let Some(left_out) = self.failure_log.allow(now_us) {
+                tracing::error!(
+                    error = %e,
+                    left_out,
+                    "bus failed: sending stops, queued setpoints dropped"
+                );
+            }
         }
         self.engine.raise(now_us, fault);
         self.transport.drop_queued();
         self.held = None;
+        self.queue_full_since = None;
         if self.bus_ok {
             self.bus_ok = false;
-            self.backoff_us = REOPEN_BACKOFF_US.0;
+            // A bus that failed again before it carried a frame since the last reopen: wait
+            // longer before the next attempt (see REOPEN_BACKOFF_US).
+            self.backoff_us = if self.carried {
+                REOPEN_BACKOFF_US.0
+            } else {
+                (self.backoff_us * 2).min(REOPEN_BACKOFF_US.1)
+            };
             self.next_reopen_us = now_us + self.backoff_us;
+        }
+    }
+
+    /// A send the queue refused: counted; the next tick's setpoints replace it. Only a queue
+    /// full for [`QUEUE_FULL_FAULT_US`] is a fault, and a transient one.
+    fn queue_full(&mut self, now_us: u64) {
+        self.tx_queue_full += 1;
+        let since = *self.queue_full_since.get_or_insert(now_us);
+        if now_us.saturating_sub(since) >= QUEUE_FULL_FAULT_US {
+            self.engine.raise(now_us, Fault::BusDegraded);
         }
     }
 
@@ -234,14 +315,19 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             Ok(()) => {
                 // Frames of the old epoch may still be queued where we cannot purge them.
                 self.engine.new_epoch();
-                tracing::warn!(
-                    epochs = ?self.engine.epochs(),
-                    "bus reopened in a new setpoint epoch; the daemon stays SAFE until `handctl arm`"
-                );
+                if let Some(left_out) = self.reopen_log.allow(now_us) {
+                    tracing::warn!(
+                        epochs = ?self.engine.epochs(),
+                        left_out,
+                        "bus reopened in a new setpoint epoch; the daemon stays SAFE until `handctl arm`"
+                    );
+                }
                 self.bus_ok = true;
+                self.carried = false;
                 true
             }
             Err(e) => {
+                self.reopen_failures += 1;
                 self.backoff_us = (self.backoff_us * 2).min(REOPEN_BACKOFF_US.1);
                 self.next_reopen_us = now_us + self.backoff_us;
                 tracing::debug!(error = %e, retry_in_us = self.backoff_us, "bus reopen failed");
@@ -269,9 +355,17 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         }
         let mut failed = None;
         for f in self.engine.safe_stop_frames() {
-            if let Err(e) = self.transport.send(f) {
-                failed = Some(e);
-                break;
+            match self.transport.send(f) {
+                Ok(()) => {}
+                // The next tick sends them again.
+                Err(TransportError::QueueFull) => {
+                    self.tx_queue_full += 1;
+                    break;
+                }
+                Err(e) => {
+                    failed = Some(e);
+                    break;
+                }
             }
         }
         if let Some(e) = failed {
@@ -327,20 +421,41 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         self.apply_commands(deadline);
         let t0 = self.clock.now_us();
         self.last_tick_on_time = self.engine.on_time(t0, deadline);
+        // Error-passive: a transient fault while it lasts (the safe stops of this tick
+        // already go out in SAFE).
+        if self.bus_ok && self.transport.health().state == ControllerState::ErrorPassive {
+            self.engine.raise(t0, Fault::BusDegraded);
+        }
         let frames = self.engine.tick(deadline, t0);
         let mut failed = None;
+        let mut refused = false;
         if self.bus_ok {
             for f in frames {
-                if let Err(e) = self.transport.send(f) {
-                    failed = Some(e);
-                    break;
+                match self.transport.send(f) {
+                    Ok(()) => {
+                        self.frames_tx += 1;
+                        self.carried = true;
+                        self.bus_load.frame(f);
+                    }
+                    // The queue is full: the rest of this tick's frames would be refused too.
+                    Err(TransportError::QueueFull) => {
+                        refused = true;
+                        break;
+                    }
+                    Err(e) => {
+                        failed = Some(e);
+                        break;
+                    }
                 }
-                self.frames_tx += 1;
-                self.bus_load.frame(f);
             }
         }
         self.bus_load.close_tick();
         let t1 = self.clock.now_us();
+        if refused {
+            self.queue_full(t1);
+        } else if failed.is_none() {
+            self.queue_full_since = None;
+        }
         if let Some(e) = failed {
             self.bus_failed(t1, &e);
         }
@@ -411,6 +526,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             frames_tx: self.frames_tx,
             bus_load: self.bus_load.load(),
             publish_skips: self.publish_skips,
+            bus: self.bus_health(),
         };
         match self.snapshot.try_lock() {
             Ok(mut s) => *s = snap,

@@ -98,6 +98,10 @@ pub struct Live {
     /// Worst-case bits (stuffing included, hand.dbc's formula) of the frames the daemon read
     /// and sent over the last second, as a fraction of the bus's 1 Mbit/s; 0..1.
     pub bus_load: f64,
+    /// The CAN controller's state and every bus error class counted (absent from a daemon
+    /// older than this field).
+    #[serde(default)]
+    pub bus: crate::protocol::BusStatus,
     /// Per EMG channel.
     pub channels: Vec<ChannelLive>,
     /// Per channel rest level of the running model's calibration (the mean RMS feature over its
@@ -129,6 +133,10 @@ impl Live {
                 frames_tx: s.frames_tx,
             },
             bus_load: s.bus_load,
+            bus: crate::protocol::BusStatus {
+                controller: s.bus.state.name().into(),
+                counters: s.bus.counters,
+            },
             channels: (0..s.channels)
                 .map(|c| ChannelLive {
                     rms_uv: s.channel_rms_uv[c],

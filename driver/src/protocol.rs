@@ -117,6 +117,19 @@ pub struct Status {
     /// The model running (absent from a daemon older than this field).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub model: Option<ModelStatus>,
+    /// The CAN bus: the controller's error state and every error class counted (absent from
+    /// a daemon older than this field).
+    #[serde(default)]
+    pub bus: BusStatus,
+}
+
+/// The CAN bus as `handctl status` shows it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub struct BusStatus {
+    /// error_active, warning, error_passive or bus_off.
+    pub controller: String,
+    /// Every error class since start.
+    pub counters: crate::transport::BusCounters,
 }
 
 /// The model a daemon runs, as `handctl status` shows it.

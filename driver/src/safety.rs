@@ -63,7 +63,7 @@ pub enum Fault {
     SignalQuality,
     /// A HAND_ESTOP frame arrived.
     EStop,
-    /// The controller went bus-off or error-passive.
+    /// The controller went bus-off (error-passive is [`Fault::BusDegraded`]).
     BusOff,
     /// The CAN interface is down or could not be opened.
     InterfaceDown,
@@ -81,11 +81,16 @@ pub enum Fault {
     /// A model was swapped in (a deploy or a rollback): the hand waits in SAFE, every finger
     /// from rest, until `arm` hands it to the new model.
     ModelSwapped,
+    /// The bus works but not well enough to trust: the CAN controller is error-passive (its
+    /// frames may go unacknowledged), or the transmit queue stayed full for longer than the
+    /// finger controllers' own setpoint timeout. Transient: it clears when the controller is
+    /// error-active and the queue takes frames again.
+    BusDegraded,
 }
 
 impl Fault {
     /// All faults, in bit order.
-    pub const ALL: [Fault; 14] = [
+    pub const ALL: [Fault; 15] = [
         Fault::EmgSilence,
         Fault::E2eError,
         Fault::InvalidWindow,
@@ -100,6 +105,7 @@ impl Fault {
         Fault::Calibrating,
         Fault::NoModel,
         Fault::ModelSwapped,
+        Fault::BusDegraded,
     ];
 
     /// Whether the fault stays until `handctl arm`.
@@ -140,6 +146,7 @@ impl Fault {
             Fault::Calibrating => "calibrating",
             Fault::NoModel => "no_model",
             Fault::ModelSwapped => "model_swapped",
+            Fault::BusDegraded => "bus_degraded",
         }
     }
 }

@@ -119,6 +119,10 @@ impl ControlHandler {
                 })
                 .collect(),
             model: self.model.clone(),
+            bus: crate::protocol::BusStatus {
+                controller: s.bus.state.name().into(),
+                counters: s.bus.counters,
+            },
         }
     }
 

@@ -1,6 +1,14 @@
 //! SocketCAN as the daemon's [`Transport`]: a non-blocking raw CAN socket with kernel receive
-//! timestamps (SO_TIMESTAMPNS) and error frames switched on, so bus-off and error-passive
-//! reach the daemon as errors, not as silence.
+//! timestamps (SO_TIMESTAMPNS) and error frames switched on, so the controller's error state
+//! reaches the daemon, not silence: bus-off as an error ([`TransportError::BusOff`]), warning
+//! and error-passive (and the return to error-active) as the controller state in
+//! [`Transport::health`], every error class counted ([`crate::transport::BusCounters`]). A
+//! full transmit queue (ENOBUFS) is [`TransportError::QueueFull`], not a dead bus.
+//!
+//! The receive buffer is sized for [`RCVBUF_BYTES`] (a few ticks of this bus); the kernel caps
+//! the request at `net.core.rmem_max`, and handd logs the size it got when that is less (the
+//! README's install section sets the sysctl). No kernel filter is set: handd reads every id on
+//! the bus, because its bus-load figure and its count of unknown frames need them all.
 //!
 //! Kernel timestamps are wall-clock times; they are mapped onto the daemon's monotonic clock
 //! by the offset measured when the socket is opened (re-measured at every reopen), so latency
@@ -14,15 +22,91 @@ use hand_clock::Clock;
 use hand_dbc::CanFrame;
 use socketcan::{CanSocket, EmbeddedFrame, Socket, SocketOptions};
 
-use crate::transport::{Timestamped, Transport, TransportError};
+use crate::transport::{BusHealth, ControllerState, Timestamped, Transport, TransportError};
 
-/// Linux `CAN_ERR_*` bits of an error frame's id and `data[1]` (linux/can/error.h).
+/// The receive buffer handd asks for: 200 ms of this bus at its worst case. hand.dbc's load is
+/// about 3,500 frames/s (EMG 3,000/s, status 250/s, the rest about 250/s); each received CAN
+/// frame costs the socket one skb, about 960 bytes of truesize on 64-bit kernels: 700 frames
+/// in 200 ms, 672,000 bytes, rounded up to 656 KiB. 200 ms is four ticks: a tick that starts
+/// three ticks late still finds every frame. The kernel default (208 KiB) holds about 60 ms.
+pub const RCVBUF_BYTES: usize = 656 * 1024;
+
+/// Linux `CAN_ERR_*` bits of an error frame's id and data bytes (linux/can/error.h).
 mod err {
+    pub const TX_TIMEOUT: u32 = 0x0001;
+    pub const LOSTARB: u32 = 0x0002;
     pub const CRTL: u32 = 0x0004;
+    pub const PROT: u32 = 0x0008;
+    pub const TRX: u32 = 0x0010;
+    pub const ACK: u32 = 0x0020;
     pub const BUSOFF: u32 = 0x0040;
+    pub const BUSERROR: u32 = 0x0080;
     pub const RESTARTED: u32 = 0x0100;
+    pub const CNT: u32 = 0x0200;
+    pub const CRTL_RX_OVERFLOW: u8 = 0x01;
+    pub const CRTL_TX_OVERFLOW: u8 = 0x02;
+    pub const CRTL_RX_WARNING: u8 = 0x04;
+    pub const CRTL_TX_WARNING: u8 = 0x08;
     pub const CRTL_RX_PASSIVE: u8 = 0x10;
     pub const CRTL_TX_PASSIVE: u8 = 0x20;
+    pub const CRTL_ACTIVE: u8 = 0x40;
+}
+
+/// `IFF_UP` and `IFF_RUNNING` (the carrier: a CAN controller that is bus-off or stopped has
+/// none) of `/sys/class/net/<if>/flags`.
+const IFF_UP: u32 = 0x1;
+const IFF_RUNNING: u32 = 0x40;
+
+/// One error frame (`CAN_ERR_*` bits of its id, its data) applied to the controller's state
+/// and the counters; true when it reports bus-off.
+pub fn on_error_frame(bits: u32, data: &[u8], health: &mut BusHealth) -> bool {
+    let c = &mut health.counters;
+    let ctrl = data.get(1).copied().unwrap_or(0);
+    if bits & err::RESTARTED != 0 {
+        c.restarted += 1;
+        health.state = ControllerState::ErrorActive;
+    }
+    if bits & err::ACK != 0 {
+        c.no_ack += 1;
+    }
+    if bits & (err::PROT | err::BUSERROR) != 0 {
+        c.protocol += 1;
+    }
+    if bits & (err::TX_TIMEOUT | err::LOSTARB | err::TRX) != 0 {
+        c.other += 1;
+    }
+    if bits & err::CRTL != 0 {
+        if ctrl & (err::CRTL_RX_OVERFLOW | err::CRTL_TX_OVERFLOW) != 0 {
+            c.controller_overflow += 1;
+        }
+        if ctrl & (err::CRTL_RX_PASSIVE | err::CRTL_TX_PASSIVE) != 0 {
+            c.passive += 1;
+            health.state = ControllerState::ErrorPassive;
+        } else if ctrl & (err::CRTL_RX_WARNING | err::CRTL_TX_WARNING) != 0 {
+            c.warning += 1;
+            health.state = ControllerState::Warning;
+        } else if ctrl & err::CRTL_ACTIVE != 0 {
+            health.state = ControllerState::ErrorActive;
+        }
+    } else if bits & err::CNT != 0 && health.state != ControllerState::BusOff {
+        // The error counters alone (bytes 6 and 7: transmit, receive).
+        let worst = data
+            .get(6)
+            .copied()
+            .unwrap_or(0)
+            .max(data.get(7).copied().unwrap_or(0));
+        health.state = match worst {
+            128.. => ControllerState::ErrorPassive,
+            96..=127 => ControllerState::Warning,
+            _ => ControllerState::ErrorActive,
+        };
+    }
+    if bits & err::BUSOFF != 0 {
+        c.bus_off += 1;
+        health.state = ControllerState::BusOff;
+        return true;
+    }
+    false
 }
 
 /// A SocketCAN interface as a transport.
@@ -31,8 +115,7 @@ pub struct SocketCanTransport<K: Clock> {
     socket: Option<CanSocket>,
     clock: K,
     offset_us: i128,
-    /// Error frames that were neither bus-off nor error-passive (counted, not fatal).
-    pub other_error_frames: u64,
+    health: BusHealth,
 }
 
 fn wall_us() -> i128 {
@@ -42,7 +125,8 @@ fn wall_us() -> i128 {
         .unwrap_or(0)
 }
 
-/// Whether `iface` exists and is administratively up.
+/// Whether `iface` exists, is administratively up and has a carrier (a CAN controller that is
+/// bus-off or stopped has none: reopening it would only fail at the first send).
 pub fn interface_up(iface: &str) -> Result<(), TransportError> {
     let dir = Path::new("/sys/class/net").join(iface);
     if !dir.exists() {
@@ -53,9 +137,15 @@ pub fn interface_up(iface: &str) -> Result<(), TransportError> {
     }
     let flags = std::fs::read_to_string(dir.join("flags")).unwrap_or_default();
     let flags = u32::from_str_radix(flags.trim().trim_start_matches("0x"), 16).unwrap_or(0);
-    if flags & 1 == 0 {
+    if flags & IFF_UP == 0 {
         return Err(TransportError::Down(format!(
             "CAN interface {iface:?} is down (`ip link set up {iface}`)"
+        )));
+    }
+    if flags & IFF_RUNNING == 0 {
+        return Err(TransportError::Down(format!(
+            "CAN interface {iface:?} has no carrier (the controller is bus-off or stopped; \
+             `ip -details link show {iface}` shows its state)"
         )));
     }
     Ok(())
@@ -69,7 +159,7 @@ impl<K: Clock> SocketCanTransport<K> {
             socket: None,
             clock,
             offset_us: 0,
-            other_error_frames: 0,
+            health: BusHealth::default(),
         };
         t.reopen()?;
         Ok(t)
@@ -77,6 +167,10 @@ impl<K: Clock> SocketCanTransport<K> {
 
     fn map_io(&self, e: std::io::Error) -> TransportError {
         match e.raw_os_error() {
+            Some(code) if code == rustix::io::Errno::NOBUFS.raw_os_error() => {
+                TransportError::QueueFull
+            }
+            _ if e.kind() == std::io::ErrorKind::WouldBlock => TransportError::QueueFull,
             Some(code)
                 if code == rustix::io::Errno::NETDOWN.raw_os_error()
                     || code == rustix::io::Errno::NXIO.raw_os_error()
@@ -85,6 +179,29 @@ impl<K: Clock> SocketCanTransport<K> {
                 TransportError::Down(format!("{}: {e}", self.iface))
             }
             _ => TransportError::Io(e),
+        }
+    }
+}
+
+impl<K: Clock> SocketCanTransport<K> {
+    /// Asks for [`RCVBUF_BYTES`]; logs what the kernel granted when it is less.
+    fn size_receive_buffer(&self, sock: &CanSocket) {
+        use std::os::fd::AsFd;
+        let fd = sock.as_fd();
+        if let Err(e) = rustix::net::sockopt::set_socket_recv_buffer_size(fd, RCVBUF_BYTES) {
+            tracing::warn!(error = %e, "could not size the CAN receive buffer");
+            return;
+        }
+        // The kernel doubles the request for its bookkeeping and caps it at rmem_max.
+        match rustix::net::sockopt::socket_recv_buffer_size(fd) {
+            Ok(got) if got / 2 < RCVBUF_BYTES => tracing::warn!(
+                wanted = RCVBUF_BYTES,
+                got = got / 2,
+                "CAN receive buffer smaller than wanted: set net.core.rmem_max to at least \
+                 the wanted size (README, install) or a late tick may lose frames"
+            ),
+            Ok(_) => {}
+            Err(e) => tracing::warn!(error = %e, "could not read the CAN receive buffer size"),
         }
     }
 }
@@ -109,18 +226,8 @@ impl<K: Clock> Transport for SocketCanTransport<K> {
                 socketcan::CanFrame::Data(d) => CanFrame::new(d.id(), d.data()),
                 socketcan::CanFrame::Remote(r) => CanFrame::new_remote(r.id(), r.dlc()),
                 socketcan::CanFrame::Error(e) => {
-                    let bits = e.error_bits();
-                    let ctrl = e.data().get(1).copied().unwrap_or(0);
-                    if bits & err::BUSOFF != 0 {
+                    if on_error_frame(e.error_bits(), e.data(), &mut self.health) {
                         return Err(TransportError::BusOff);
-                    }
-                    if bits & err::CRTL != 0
-                        && ctrl & (err::CRTL_RX_PASSIVE | err::CRTL_TX_PASSIVE) != 0
-                    {
-                        return Err(TransportError::ErrorPassive);
-                    }
-                    if bits & err::RESTARTED == 0 {
-                        self.other_error_frames += 1;
                     }
                     continue;
                 }
@@ -163,6 +270,10 @@ impl<K: Clock> Transport for SocketCanTransport<K> {
         self.socket = None;
     }
 
+    fn health(&self) -> BusHealth {
+        self.health
+    }
+
     fn reopen(&mut self) -> Result<(), TransportError> {
         self.socket = None;
         interface_up(&self.iface)?;
@@ -171,6 +282,8 @@ impl<K: Clock> Transport for SocketCanTransport<K> {
         sock.set_recv_timestamp(true).map_err(|e| self.map_io(e))?;
         sock.set_error_filter_accept_all()
             .map_err(|e| self.map_io(e))?;
+        self.size_receive_buffer(&sock);
+        self.health.state = ControllerState::ErrorActive;
         self.offset_us = wall_us() - self.clock.now_us() as i128;
         self.socket = Some(sock);
         Ok(())
@@ -180,6 +293,57 @@ impl<K: Clock> Transport for SocketCanTransport<K> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn frame(bits: u32, ctrl: u8) -> (u32, [u8; 8]) {
+        (bits, [0, ctrl, 0, 0, 0, 0, 0, 0])
+    }
+
+    #[test]
+    fn error_passive_is_a_state_that_clears_and_only_bus_off_is_an_error() {
+        let mut h = BusHealth::default();
+        let (b, d) = frame(err::CRTL, err::CRTL_TX_WARNING);
+        assert!(!on_error_frame(b, &d, &mut h));
+        assert_eq!(h.state, ControllerState::Warning);
+        let (b, d) = frame(err::CRTL | err::ACK, err::CRTL_TX_PASSIVE);
+        assert!(
+            !on_error_frame(b, &d, &mut h),
+            "error-passive is not bus-off"
+        );
+        assert_eq!(h.state, ControllerState::ErrorPassive);
+        let (b, d) = frame(err::CRTL, err::CRTL_ACTIVE);
+        assert!(!on_error_frame(b, &d, &mut h));
+        assert_eq!(
+            h.state,
+            ControllerState::ErrorActive,
+            "back to error-active"
+        );
+        let (b, d) = frame(err::BUSOFF, 0);
+        assert!(on_error_frame(b, &d, &mut h));
+        assert_eq!(h.state, ControllerState::BusOff);
+        let (b, d) = frame(err::RESTARTED, 0);
+        assert!(!on_error_frame(b, &d, &mut h));
+        assert_eq!(h.state, ControllerState::ErrorActive, "restarted");
+        let (b, d) = frame(err::CRTL | err::PROT | err::LOSTARB, err::CRTL_RX_OVERFLOW);
+        assert!(!on_error_frame(b, &d, &mut h));
+        let c = h.counters;
+        assert_eq!(
+            (c.warning, c.passive, c.no_ack, c.bus_off, c.restarted),
+            (1, 1, 1, 1, 1)
+        );
+        assert_eq!((c.controller_overflow, c.protocol, c.other), (1, 1, 1));
+    }
+
+    #[test]
+    fn the_error_counters_alone_give_the_state() {
+        let mut h = BusHealth::default();
+        let cnt = |tx: u8, rx: u8| [0, 0, 0, 0, 0, 0, tx, rx];
+        assert!(!on_error_frame(err::CNT, &cnt(130, 0), &mut h));
+        assert_eq!(h.state, ControllerState::ErrorPassive);
+        assert!(!on_error_frame(err::CNT, &cnt(0, 100), &mut h));
+        assert_eq!(h.state, ControllerState::Warning);
+        assert!(!on_error_frame(err::CNT, &cnt(3, 4), &mut h));
+        assert_eq!(h.state, ControllerState::ErrorActive);
+    }
 
     #[test]
     fn a_missing_interface_says_how_to_create_it() {

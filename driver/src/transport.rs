@@ -9,21 +9,86 @@
 
 use hand_dbc::CanFrame;
 
-/// Why the bus cannot be used.
+/// Why a transport call failed.
 #[derive(Debug, thiserror::Error)]
 pub enum TransportError {
     /// The controller is bus-off.
     #[error("CAN controller is bus-off")]
     BusOff,
-    /// The controller is error-passive: its frames may not be seen reliably.
-    #[error("CAN controller is error-passive")]
-    ErrorPassive,
+    /// The interface's transmit queue is full (ENOBUFS): the frame was not queued. On a real
+    /// controller this happens whenever the bus is busy or nobody ACKs; it is not a dead bus.
+    #[error("CAN transmit queue full: frame not queued")]
+    QueueFull,
     /// The interface is down or gone.
     #[error("CAN interface is down: {0}")]
     Down(String),
     /// Any other I/O error.
     #[error("CAN I/O error: {0}")]
     Io(#[from] std::io::Error),
+}
+
+/// The CAN controller's error state (ISO 11898-1 fault confinement), as its error frames
+/// report it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ControllerState {
+    /// Error-active: error counters below 96.
+    #[default]
+    ErrorActive,
+    /// Error warning: a counter at 96 or more.
+    Warning,
+    /// Error-passive: a counter at 128 or more. The node still sends and receives, but its
+    /// frames may go unacknowledged; what happens when the amplifier or the controllers power
+    /// up after the board, brown out, or motor EMI hits the bus. Transient: it clears when the
+    /// controller is error-active again.
+    ErrorPassive,
+    /// Bus-off: the controller left the bus (transmit counter above 255).
+    BusOff,
+}
+
+impl ControllerState {
+    /// A stable lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            ControllerState::ErrorActive => "error_active",
+            ControllerState::Warning => "warning",
+            ControllerState::ErrorPassive => "error_passive",
+            ControllerState::BusOff => "bus_off",
+        }
+    }
+}
+
+/// Every class of bus error since start, counted (`handctl status` shows them).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub struct BusCounters {
+    /// Error frames reporting error warning (a counter at 96).
+    pub warning: u64,
+    /// Error frames reporting error-passive.
+    pub passive: u64,
+    /// Bus-off reports.
+    pub bus_off: u64,
+    /// Controller restarts after bus-off (CAN_ERR_RESTARTED).
+    pub restarted: u64,
+    /// Transmissions nobody acknowledged (CAN_ERR_ACK).
+    pub no_ack: u64,
+    /// Receive or transmit overflows in the controller (frames lost in hardware).
+    pub controller_overflow: u64,
+    /// Protocol violations and bus errors.
+    pub protocol: u64,
+    /// Other error frames (lost arbitration, transceiver, transmit timeout).
+    pub other: u64,
+    /// Frames the interface's transmit queue refused (ENOBUFS), counted by the daemon.
+    pub tx_queue_full: u64,
+    /// Reopen attempts that failed.
+    pub reopen_failures: u64,
+}
+
+/// The bus's health now.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct BusHealth {
+    /// The controller's error state.
+    pub state: ControllerState,
+    /// Every error class, counted.
+    pub counters: BusCounters,
 }
 
 /// A received frame and its receive time, µs on the daemon's clock.
@@ -42,4 +107,9 @@ pub trait Transport {
     fn drop_queued(&mut self);
     /// Try to bring the bus back (reopen the socket).
     fn reopen(&mut self) -> Result<(), TransportError>;
+    /// The controller's error state and error counts (a transport without a controller is
+    /// always error-active).
+    fn health(&self) -> BusHealth {
+        BusHealth::default()
+    }
 }

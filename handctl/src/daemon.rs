@@ -68,7 +68,9 @@ pub fn format_status(s: &Status) -> String {
          ticks {}   deadline misses {}   EMG samples lost {}   bad frames {}\n\
          latency (newest sample -> setpoints) p50 {} us  p99 {} us  max {} us\n\
          compute per tick                     p50 {} us  p99 {} us  max {} us\n\
-         tick start after its deadline        p50 {} us  p99 {} us  max {} us\n\n\
+         tick start after its deadline        p50 {} us  p99 {} us  max {} us\n\
+         CAN controller {}   errors: warning {} passive {} bus-off {} restarted {} no-ACK {} \
+         overflow {} protocol {} other {}; transmit queue full {}; reopen failures {}\n\n\
          {:<7} {:>7} {:>9} {:>11} {:>11} {:>7} {:>7}  {}\n",
         s.state,
         s.faults,
@@ -85,6 +87,21 @@ pub fn format_status(s: &Status) -> String {
         s.lateness.p50_us,
         s.lateness.p99_us,
         s.lateness.max_us,
+        if s.bus.controller.is_empty() {
+            "?"
+        } else {
+            &s.bus.controller
+        },
+        s.bus.counters.warning,
+        s.bus.counters.passive,
+        s.bus.counters.bus_off,
+        s.bus.counters.restarted,
+        s.bus.counters.no_ack,
+        s.bus.counters.controller_overflow,
+        s.bus.counters.protocol,
+        s.bus.counters.other,
+        s.bus.counters.tx_queue_full,
+        s.bus.counters.reopen_failures,
         "finger",
         "label",
         "force N",

@@ -4058,7 +4058,7 @@ impl HandHeartbeat {
         self.state = value;
     }
 
-    /// `FaultMask` (bitmask): handd's active faults, one bit each, as handctl status names them: bit 0 emg_silence, bit 1 e2e_error, bit 2 invalid_window, bit 3 non_finite, bit 4 signal_quality, bit 5 estop, bit 6 bus_off, bit 7 interface_down, bit 8 repeated_e2e, bit 9 model_error, bit 10 stop_requested, bit 11 calibrating, bit 12 no_model, bit 13 model_swapped; bits 14..15 unused. A finger whose controller fell silent is not a daemon fault: FINGER_STATUS and handctl status show it.
+    /// `FaultMask` (bitmask): handd's active faults, one bit each, as handctl status names them: bit 0 emg_silence, bit 1 e2e_error, bit 2 invalid_window, bit 3 non_finite, bit 4 signal_quality, bit 5 estop, bit 6 bus_off, bit 7 interface_down, bit 8 repeated_e2e, bit 9 model_error, bit 10 stop_requested, bit 11 calibrating, bit 12 no_model, bit 13 model_swapped, bit 14 bus_degraded; bit 15 unused. A finger whose controller fell silent is not a daemon fault: FINGER_STATUS and handctl status show it.
     pub fn fault_mask(&self) -> u16 {
         self.fault_mask
     }
@@ -5953,7 +5953,7 @@ pub const MESSAGES: &[MessageInfo] = &[
             SignalInfo { name: "Crc", start_bit: 0, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "crc", values: &[], comment: "" },
             SignalInfo { name: "Counter", start_bit: 8, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 15.0, raw_min: 0, raw_max: 15, unit: "count", values: &[], comment: "" },
             SignalInfo { name: "State", start_bit: 12, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 3.0, raw_min: 0, raw_max: 3, unit: "enum", values: &[(0, "BOOT"), (1, "READY"), (2, "RUNNING"), (3, "SAFE")], comment: "" },
-            SignalInfo { name: "FaultMask", start_bit: 16, size: 16, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 65535.0, raw_min: 0, raw_max: 65535, unit: "bitmask", values: &[], comment: "handd's active faults, one bit each, as handctl status names them: bit 0 emg_silence, bit 1 e2e_error, bit 2 invalid_window, bit 3 non_finite, bit 4 signal_quality, bit 5 estop, bit 6 bus_off, bit 7 interface_down, bit 8 repeated_e2e, bit 9 model_error, bit 10 stop_requested, bit 11 calibrating, bit 12 no_model, bit 13 model_swapped; bits 14..15 unused. A finger whose controller fell silent is not a daemon fault: FINGER_STATUS and handctl status show it." },
+            SignalInfo { name: "FaultMask", start_bit: 16, size: 16, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 65535.0, raw_min: 0, raw_max: 65535, unit: "bitmask", values: &[], comment: "handd's active faults, one bit each, as handctl status names them: bit 0 emg_silence, bit 1 e2e_error, bit 2 invalid_window, bit 3 non_finite, bit 4 signal_quality, bit 5 estop, bit 6 bus_off, bit 7 interface_down, bit 8 repeated_e2e, bit 9 model_error, bit 10 stop_requested, bit 11 calibrating, bit 12 no_model, bit 13 model_swapped, bit 14 bus_degraded; bit 15 unused. A finger whose controller fell silent is not a daemon fault: FINGER_STATUS and handctl status show it." },
             SignalInfo { name: "ModelId", start_bit: 32, size: 32, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 4294967295.0, raw_min: 0, raw_max: 4294967295, unit: "id", values: &[], comment: "First 4 bytes (little-endian) of the loaded model file's checksum; 0 when no model is loaded." },
         ],
     },

@@ -13,6 +13,7 @@ use decoder::model::{
 use driver::daemon::Runner;
 use driver::engine::{Engine, EngineSettings};
 use driver::mem_transport::MemTransport;
+use driver::transport::Transport;
 use hand_dbc::messages::{FingerMode, FingerSetpoint};
 use hand_dbc::CanFrame;
 use hand_model::faults::FaultPlan;
@@ -35,12 +36,13 @@ pub fn random_predictor(seed: u64) -> Predictor {
         .predictor()
 }
 
-/// World + daemon + probe.
-pub struct Rig {
+/// World + daemon + probe; the daemon reaches the bus through `T` (the in-memory bus itself,
+/// or a wrapper that misbehaves on cue).
+pub struct Rig<T: Transport = MemTransport<VirtualClock>> {
     pub clock: VirtualClock,
     pub bus: MemBus,
     pub world: World<MemEndpoint>,
-    pub runner: Runner<MemTransport<VirtualClock>, VirtualClock>,
+    pub runner: Runner<T, VirtualClock>,
     pub probe: MemEndpoint,
     /// Every frame the probe saw, with its time.
     pub seen: Vec<(u64, CanFrame)>,
@@ -54,6 +56,18 @@ impl Rig {
 
     /// Any patient and model.
     pub fn with_predictor(faults: FaultPlan, patient: PatientMode, predictor: Predictor) -> Self {
+        Rig::with_transport(faults, patient, predictor, |t| t)
+    }
+}
+
+impl<T: Transport> Rig<T> {
+    /// Any patient and model, the daemon's transport wrapped by `wrap`.
+    pub fn with_transport(
+        faults: FaultPlan,
+        patient: PatientMode,
+        predictor: Predictor,
+        wrap: impl FnOnce(MemTransport<VirtualClock>) -> T,
+    ) -> Self {
         let clock = VirtualClock::new();
         let bus = MemBus::with_clock(clock.clone());
         let b = bus.clone();
@@ -69,7 +83,7 @@ impl Rig {
         let chain = ChainConfig::default().validate().unwrap();
         let mut engine = Engine::new(&chain, predictor, EngineSettings::default(), 0);
         engine.validated(0);
-        let transport = MemTransport::new(bus.endpoint(), clock.clone());
+        let transport = wrap(MemTransport::new(bus.endpoint(), clock.clone()));
         let runner = Runner::new(engine, transport, clock.clone(), 50_000);
         let probe = bus.endpoint();
         Self {
@@ -134,7 +148,7 @@ impl Rig {
     }
 }
 
-impl Rig {
+impl<T: Transport> Rig<T> {
     /// The virtual time now.
     pub fn clock_now(&self) -> u64 {
         self.clock.now_us()

@@ -45,6 +45,18 @@ impl MonitorState {
         d.e2e_errors = l.counters.e2e_errors;
         d.samples_lost = l.counters.samples_lost;
         d.bus_load = Some(l.bus_load);
+        if !l.bus.controller.is_empty() {
+            let c = &l.bus.counters;
+            let errors = c.warning
+                + c.passive
+                + c.bus_off
+                + c.no_ack
+                + c.controller_overflow
+                + c.protocol
+                + c.other
+                + c.tx_queue_full;
+            d.can = Some(format!("{}, {errors} errors", l.bus.controller));
+        }
         self.update_noisy();
         self.sample_history();
     }

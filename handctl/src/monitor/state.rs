@@ -65,6 +65,9 @@ pub struct DaemonView {
     pub samples_lost: u64,
     /// Bus load, fraction of the bit rate over the last second.
     pub bus_load: Option<f64>,
+    /// The CAN controller's state and its error count since start, e.g. "error_active, 0
+    /// errors" (from the daemon's live lines).
+    pub can: Option<String>,
 }
 
 /// Scrolling history of every finger's label and reported force, one point per sample.

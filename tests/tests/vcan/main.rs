@@ -640,6 +640,74 @@ fn d6_bus_off_error_frame() {
     );
 }
 
+/// Issue 30: error-passive is not bus-off. An error frame saying the controller went
+/// error-passive stops the hand (a transient fault), one saying it is error-active again lets
+/// it run again by itself after the recovery time, with no `handctl arm`; `handctl status`
+/// counts the passive report.
+#[test]
+fn d6b_error_passive_is_transient() {
+    let rig = Rig::start("error-passive", DRILL_SILENCE_MS);
+    let mut sim = rig.sim("sine", RUN_S, &[]);
+    let w = writer(&rig.env.iface);
+    let start = wait_scenario_start(&rig.monitor);
+    while now_us() < start + ONSET_US {
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    // CAN_ERR_CRTL with CAN_ERR_CRTL_TX_PASSIVE, then CAN_ERR_CRTL_ACTIVE 300 ms later.
+    let passive = socketcan::CanErrorFrame::new_error(0x0004, &[0, 0x20, 0, 0, 0, 0, 0, 0])
+        .expect("error frame");
+    w.write_frame(&passive)
+        .expect("vcan accepts an injected error frame");
+    std::thread::sleep(Duration::from_millis(300));
+    let active = socketcan::CanErrorFrame::new_error(0x0004, &[0, 0x40, 0, 0, 0, 0, 0, 0])
+        .expect("error frame");
+    w.write_frame(&active)
+        .expect("vcan accepts an injected error frame");
+    let back_at = now_us();
+    sim.wait_success(Duration::from_secs(60));
+    let status = rig.cfg.status(&rig.env);
+    let seen = rig.monitor.finish();
+    let onset = seen
+        .iter()
+        .find(|s| s.frame.is_none() && s.time_us >= start)
+        .map(|s| s.time_us)
+        .expect("the monitor saw the injected error frame");
+    let sps = setpoints_of(&seen);
+    assert!(
+        active_between(&sps, onset - 500_000, onset) > 0,
+        "error-passive: handd was not RUNNING before the error frame"
+    );
+    let stopped = first_safe_stop_after(&sps, onset, &ALL).expect("every finger safe-stopped");
+    let resumed = sps
+        .iter()
+        .find(|s| s.time_us > back_at && s.mode == FingerMode::Active)
+        .map(|s| s.time_us)
+        .expect("error-passive: never ACTIVE again after error-active (it must not latch)");
+    println!(
+        "drill error-passive: every finger safe-stopped {:.1} ms after the report (bar {} ms); \
+         ACTIVE again by itself {:.1} ms after error-active; status: controller {}, passive \
+         reports {}",
+        (stopped - onset) as f64 * 1e-3,
+        SAFE_STOP_BAR_US / 1000,
+        (resumed - back_at) as f64 * 1e-3,
+        status.bus.controller,
+        status.bus.counters.passive
+    );
+    assert!(
+        stopped - onset <= SAFE_STOP_BAR_US,
+        "error-passive: safe stop {} us after the report",
+        stopped - onset
+    );
+    assert!(
+        resumed - back_at <= ARM_BAR_US,
+        "error-passive: ACTIVE {} us after error-active (bar {ARM_BAR_US})",
+        resumed - back_at
+    );
+    assert_eq!(status.bus.controller, "error_active");
+    assert_eq!(status.bus.counters.passive, 1);
+    assert_eq!(status.bus.counters.bus_off, 0);
+}
+
 #[test]
 fn d7_interface_down_and_up() {
     let mut rig = Rig::start("link-down", DRILL_SILENCE_MS);

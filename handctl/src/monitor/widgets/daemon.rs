@@ -72,7 +72,7 @@ impl Widget for DaemonPanel<'_> {
             Span::raw(format!("  faults {faults}  model {model}")),
         ]);
         let second = Line::from(format!(
-            "latency p50 {} p99 {} us  misses {}  E2E {}  lost {}  bus {}",
+            "latency p50 {} p99 {} us  misses {}  E2E {}  lost {}  bus {}  CAN {}",
             opt(d.latency_p50_us),
             opt(d.latency_p99_us),
             d.deadline_misses.saturating_sub(b.deadline_misses),
@@ -80,6 +80,7 @@ impl Widget for DaemonPanel<'_> {
             d.samples_lost.saturating_sub(b.samples_lost),
             d.bus_load
                 .map_or_else(|| "--".to_owned(), |l| format!("{:.1}%", l * 100.0)),
+            d.can.as_deref().unwrap_or("--"),
         ));
         Paragraph::new(vec![first, second]).render(area, buf);
     }
