@@ -33,7 +33,9 @@ struct Args {
     /// Log as JSON lines (for log collectors) instead of human-readable text.
     #[arg(long)]
     json_logs: bool,
-    /// SCHED_FIFO priority of the control loop (1-99); normal scheduling if not given.
+    /// SCHED_FIFO priority of the control loop (1-99); normal scheduling if not given. Keep it
+    /// below 50, the kernel's threaded interrupt handlers (the CAN controller's among them):
+    /// handd warns at 50 or more.
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=99))]
     rt_priority: Option<u8>,
     /// Check the config and the model, print what would run, and exit.
@@ -51,12 +53,23 @@ fn use_colour(json: bool, stderr_is_tty: bool, no_color: Option<&std::ffi::OsStr
 /// SCHED_FIFO at `priority` for the calling thread (the loop's), if asked; a refusal is logged.
 fn loop_priority(priority: Option<u8>) {
     let Some(p) = priority else { return };
+    if p >= IRQ_THREAD_PRIORITY {
+        tracing::warn!(
+            priority = p,
+            "the control loop's SCHED_FIFO priority is not below the kernel's threaded interrupt \
+             handlers ({IRQ_THREAD_PRIORITY}): the CAN interrupt cannot preempt a tick and the \
+             controller's receive buffers may overflow; use 40 as the shipped unit does"
+        );
+    }
     let mut rt = RtReport::default();
     set_fifo(p, &mut rt);
     for w in &rt.warnings {
         tracing::warn!("{w}");
     }
 }
+
+/// SCHED_FIFO priority of the kernel's threaded interrupt handlers.
+const IRQ_THREAD_PRIORITY: u8 = 50;
 
 fn init_logs(json: bool) {
     let filter = tracing_subscriber::EnvFilter::try_from_default_env()
