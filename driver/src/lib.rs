@@ -20,6 +20,7 @@ pub mod mem_transport;
 pub mod model_service;
 pub mod protocol;
 pub mod rt;
+pub mod rx_times;
 pub mod safety;
 pub mod service;
 pub mod socketcan_bus;

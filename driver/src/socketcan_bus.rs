@@ -10,10 +10,9 @@
 //! README's install section sets the sysctl). No kernel filter is set: handd reads every id on
 //! the bus, because its bus-load figure and its count of unknown frames need them all.
 //!
-//! Kernel timestamps are wall-clock times; they are mapped onto the daemon's monotonic clock
-//! by the offset measured when the socket is opened (re-measured at every reopen), so latency
-//! figures compare like with like. A wall-clock step between two opens shifts latencies by
-//! that step until the next reopen: the figures are diagnostics, never used for control.
+//! Kernel timestamps are wall-clock times; [`RxTimes`] maps them onto the daemon's monotonic
+//! clock by an offset re-measured at every read, so a step of the wall clock (NTP's first
+//! sync, `date -s`) neither stales every window nor hides frames past the tick's deadline.
 
 use std::path::Path;
 use std::time::{SystemTime, UNIX_EPOCH};
@@ -22,6 +21,7 @@ use hand_clock::Clock;
 use hand_dbc::CanFrame;
 use socketcan::{CanSocket, EmbeddedFrame, Socket, SocketOptions};
 
+use crate::rx_times::RxTimes;
 use crate::transport::{BusHealth, ControllerState, Timestamped, Transport, TransportError};
 
 /// The receive buffer handd asks for: 200 ms of this bus at its worst case. hand.dbc's load is
@@ -114,7 +114,7 @@ pub struct SocketCanTransport<K: Clock> {
     iface: String,
     socket: Option<CanSocket>,
     clock: K,
-    offset_us: i128,
+    rx_times: RxTimes,
     health: BusHealth,
 }
 
@@ -158,7 +158,7 @@ impl<K: Clock> SocketCanTransport<K> {
             iface: iface.to_owned(),
             socket: None,
             clock,
-            offset_us: 0,
+            rx_times: RxTimes::default(),
             health: BusHealth::default(),
         };
         t.reopen()?;
@@ -221,7 +221,8 @@ impl<K: Clock> Transport for SocketCanTransport<K> {
                 .duration_since(UNIX_EPOCH)
                 .map(|d| d.as_micros() as i128)
                 .unwrap_or(0);
-            let rx_us = (ts_us - self.offset_us).max(0) as u64;
+            let rx_us = self.rx_times.map(ts_us, wall_us(), self.clock.now_us());
+            self.health.counters.clock_steps = self.rx_times.steps();
             let ours = match frame {
                 socketcan::CanFrame::Data(d) => CanFrame::new(d.id(), d.data()),
                 socketcan::CanFrame::Remote(r) => CanFrame::new_remote(r.id(), r.dlc()),
@@ -284,7 +285,7 @@ impl<K: Clock> Transport for SocketCanTransport<K> {
             .map_err(|e| self.map_io(e))?;
         self.size_receive_buffer(&sock);
         self.health.state = ControllerState::ErrorActive;
-        self.offset_us = wall_us() - self.clock.now_us() as i128;
+        self.rx_times.reset();
         self.socket = Some(sock);
         Ok(())
     }

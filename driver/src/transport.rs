@@ -80,6 +80,10 @@ pub struct BusCounters {
     pub tx_queue_full: u64,
     /// Reopen attempts that failed.
     pub reopen_failures: u64,
+    /// Steps of the wall clock seen in the receive stamps ([`crate::rx_times`]): followed,
+    /// counted, never a fault.
+    #[serde(default)]
+    pub clock_steps: u64,
 }
 
 /// The bus's health now.

@@ -70,7 +70,8 @@ pub fn format_status(s: &Status) -> String {
          compute per tick                     p50 {} us  p99 {} us  max {} us\n\
          tick start after its deadline        p50 {} us  p99 {} us  max {} us\n\
          CAN controller {}   errors: warning {} passive {} bus-off {} restarted {} no-ACK {} \
-         overflow {} protocol {} other {}; transmit queue full {}; reopen failures {}\n\n\
+         overflow {} protocol {} other {}; transmit queue full {}; reopen failures {}; wall-clock \
+         steps {}\n\n\
          {:<7} {:>7} {:>9} {:>11} {:>11} {:>7} {:>7}  {}\n",
         s.state,
         s.faults,
@@ -102,6 +103,7 @@ pub fn format_status(s: &Status) -> String {
         s.bus.counters.other,
         s.bus.counters.tx_queue_full,
         s.bus.counters.reopen_failures,
+        s.bus.counters.clock_steps,
         "finger",
         "label",
         "force N",
