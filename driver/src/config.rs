@@ -222,6 +222,28 @@ impl Default for ControlConfig {
     }
 }
 
+/// What a deployed model's recorded verification must show (issue 32): a model verified with a
+/// loose tolerance, or on a handful of rays, proves little, and `deploy` refuses it without
+/// `--force` as it refuses a failed one.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct DeployConfig {
+    /// The largest verification tolerance accepted (label units; `handctl train` verifies at
+    /// 0.01 unless told otherwise).
+    pub max_tolerance: f64,
+    /// The fewest calibration rays the verification must have checked.
+    pub min_rays: usize,
+}
+
+impl Default for DeployConfig {
+    fn default() -> Self {
+        Self {
+            max_tolerance: 0.05,
+            min_rays: 100,
+        }
+    }
+}
+
 /// The whole configuration.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -243,6 +265,8 @@ pub struct Config {
     pub fingers: Fingers,
     /// The control socket.
     pub control: ControlConfig,
+    /// What `deploy` demands of a model's verification.
+    pub deploy: DeployConfig,
 }
 
 impl Default for Config {
@@ -256,6 +280,7 @@ impl Default for Config {
             timeouts: Timeouts::default(),
             fingers: Fingers::default(),
             control: ControlConfig::default(),
+            deploy: DeployConfig::default(),
         }
     }
 }
@@ -371,6 +396,18 @@ impl Config {
             let finger = self.fingers.get(f);
             finger.validate(&format!("fingers.{name}"))?;
             finger.validate_slew(&format!("fingers.{name}"), self.tick_ms)?;
+        }
+        check_f64(
+            "deploy.max_tolerance".into(),
+            self.deploy.max_tolerance,
+            (0.0, 0.5),
+        )?;
+        if !(1..=10_000_000).contains(&self.deploy.min_rays) {
+            return Err(ConfigError::Invalid {
+                field: "deploy.min_rays".into(),
+                value: self.deploy.min_rays.to_string(),
+                allowed: "1 to 10000000".into(),
+            });
         }
         if self.control.socket.as_os_str().is_empty() {
             return Err(ConfigError::Invalid {

@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 use decoder::dsp::ChainConfig;
 
-use crate::config::Config;
+use crate::config::{Config, DeployConfig};
 use crate::control::Peer;
 use crate::startup::{check_model, LoadedModel, StartupError};
 
@@ -41,6 +41,14 @@ pub enum DeployError {
         /// What the file records.
         verification: String,
     },
+    /// The recorded verification passed, but looser or on fewer rays than the config demands.
+    #[error("model {path}: {why}; refused (deploy with --force to run it anyway)")]
+    WeakVerification {
+        /// The model file.
+        path: PathBuf,
+        /// What falls short, with the config's figure.
+        why: String,
+    },
     /// The model file or the config could not be written.
     #[error("could not install the model: {0}; nothing changed")]
     Install(String),
@@ -63,8 +71,14 @@ pub struct Prepared {
 }
 
 /// Reads and checks the model at `path` for a loop running `chain` (see the module doc). A
-/// model whose file records no verification, or one that failed, is refused unless `force`.
-pub fn prepare(path: &str, chain: &ChainConfig, force: bool) -> Result<Prepared, DeployError> {
+/// model whose file records no verification, or one that failed, or one verified looser or on
+/// fewer rays than `policy` demands, is refused unless `force`.
+pub fn prepare(
+    path: &str,
+    chain: &ChainConfig,
+    policy: &DeployConfig,
+    force: bool,
+) -> Result<Prepared, DeployError> {
     let source = PathBuf::from(path);
     if !source.is_absolute() {
         return Err(DeployError::NotAbsolute(path.to_owned()));
@@ -92,11 +106,33 @@ pub fn prepare(path: &str, chain: &ChainConfig, force: bool) -> Result<Prepared,
             verification: status.verification,
         });
     }
+    if let (Some(why), false) = (weak_verification(&loaded, policy), force) {
+        return Err(DeployError::WeakVerification { path: source, why });
+    }
     Ok(Prepared {
         loaded,
         bytes,
         source,
     })
+}
+
+/// What a passed verification lacks against `policy`, if anything.
+fn weak_verification(loaded: &LoadedModel, policy: &DeployConfig) -> Option<String> {
+    let v = loaded.model.verification()?;
+    let mut short = Vec::new();
+    if v.tolerance > policy.max_tolerance {
+        short.push(format!(
+            "verified at tolerance {}, the config allows at most {} (deploy.max_tolerance)",
+            v.tolerance, policy.max_tolerance
+        ));
+    }
+    if v.rays < policy.min_rays {
+        short.push(format!(
+            "verified on {} rays, the config demands at least {} (deploy.min_rays)",
+            v.rays, policy.min_rays
+        ));
+    }
+    (!short.is_empty()).then(|| short.join("; "))
 }
 
 /// The fields where the model's chain and the running one differ, "field: model A, running B",
@@ -175,5 +211,83 @@ pub fn audit(log: &Path, user: &str, peer: Peer, action: &str) {
     };
     if let Err(e) = write() {
         tracing::warn!(error = %e, path = %log.display(), "audit log not written");
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use decoder::model::verify::{Method, VerificationRecord, WorstRay};
+    use decoder::model::{
+        AnyModel, ModelKind, ModelSpec, Normalizer, TrainedModel, TrainingSummary,
+    };
+
+    use super::*;
+
+    /// A ResDD model on the default chain whose file records `tolerance` over `rays` rays, none
+    /// reversing.
+    fn model_file(dir: &Path, name: &str, tolerance: f64, rays: usize) -> String {
+        let chain = ChainConfig::default();
+        let n_in = 8 * chain.channels;
+        let spec = ModelSpec::default();
+        let model = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, 3).expect("model");
+        let norm = Normalizer::from_scales(vec![100.0; n_in]).expect("normalizer");
+        let record = VerificationRecord {
+            method: Method::Exact,
+            tolerance,
+            rays,
+            reversing: 0,
+            worst: (rays > 0).then(|| WorstRay {
+                trial: "trial 1 (index flexion, repetition 1)".into(),
+                finger: 1,
+                amount: 0.0,
+                from_k: 0.0,
+                to_k: 0.0,
+            }),
+            forced: false,
+        };
+        let path = dir.join(name);
+        TrainedModel::new(
+            model,
+            spec,
+            norm,
+            chain,
+            TrainingSummary::untrained(ModelKind::ResDd),
+        )
+        .expect("trained model")
+        .with_verification(record)
+        .expect("record")
+        .save(&path)
+        .expect("save");
+        path.display().to_string()
+    }
+
+    #[test]
+    fn a_verification_looser_or_smaller_than_the_config_demands_is_refused_without_force() {
+        let dir = std::env::temp_dir().join(format!("handd-deploy-policy-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let chain = ChainConfig::default();
+        let policy = DeployConfig::default();
+        let good = model_file(&dir, "good.hsm", 0.01, 3375);
+        assert!(prepare(&good, &chain, &policy, false).is_ok());
+        let loose = model_file(&dir, "loose.hsm", 1.0, 3375);
+        let e = prepare(&loose, &chain, &policy, false)
+            .err()
+            .expect("refused");
+        assert!(
+            matches!(e, DeployError::WeakVerification { .. })
+                && e.to_string()
+                    .contains("tolerance 1, the config allows at most 0.05"),
+            "{e}"
+        );
+        let none = model_file(&dir, "none.hsm", 0.01, 0);
+        let e = prepare(&none, &chain, &policy, false)
+            .err()
+            .expect("refused");
+        assert!(e.to_string().contains("on 0 rays"), "{e}");
+        assert!(
+            prepare(&none, &chain, &policy, true).is_ok(),
+            "--force deploys it"
+        );
+        std::fs::remove_dir_all(&dir).expect("clean up");
     }
 }

@@ -63,7 +63,7 @@ impl ControlHandler {
 
     /// `deploy`: checked, installed, swapped in; refused with nothing changed otherwise.
     pub(crate) fn deploy(&mut self, path: &str, force: bool, peer: Peer, user: &str) -> Reply {
-        let prepared = match prepare(path, &self.chain, force) {
+        let prepared = match prepare(path, &self.chain, &self.config.deploy, force) {
             Ok(p) => p,
             Err(e) => return refused(e),
         };

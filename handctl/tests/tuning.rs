@@ -153,9 +153,15 @@ fn saved_model(path: &std::path::Path, chain: decoder::dsp::ChainConfig, seed: u
     let record = VerificationRecord {
         method: Method::Exact,
         tolerance: 0.01,
-        rays: 0,
+        rays: 500,
         reversing: 0,
-        worst: None,
+        worst: Some(decoder::model::verify::WorstRay {
+            trial: "trial 1 (index flexion, repetition 1)".into(),
+            finger: 1,
+            amount: 0.0,
+            from_k: 0.0,
+            to_k: 0.0,
+        }),
         forced: false,
     };
     TrainedModel::new(model, spec, norm, chain, summary)

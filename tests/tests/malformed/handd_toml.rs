@@ -49,6 +49,8 @@ fn is_field(field: &str) -> bool {
         "timeouts.finger_silence_ms",
         "timeouts.recovery_ms",
         "control.socket",
+        "deploy.max_tolerance",
+        "deploy.min_rays",
     ];
     const FINGER: &[&str] = &[
         "kf",
