@@ -55,12 +55,16 @@ fn split(bytes: &[u8]) -> Parts {
 }
 
 fn join(p: &Parts) -> Vec<u8> {
+    join_version(p, decoder::model::FORMAT_VERSION)
+}
+
+fn join_version(p: &Parts, version: u32) -> Vec<u8> {
     let meta = serde_json::to_vec(&p.meta).unwrap();
     let mut body = (meta.len() as u64).to_le_bytes().to_vec();
     body.extend_from_slice(&meta);
     body.extend_from_slice(&p.data);
     let mut out = MAGIC.to_vec();
-    out.extend_from_slice(&1u32.to_le_bytes());
+    out.extend_from_slice(&version.to_le_bytes());
     out.extend_from_slice(&crc32fast::hash(&body).to_le_bytes());
     out.extend_from_slice(&(body.len() as u64).to_le_bytes());
     out.extend_from_slice(&body);
@@ -145,7 +149,7 @@ fn load_rejects_each_defect_with_a_named_error() {
         load(&v),
         FileError::UnknownVersion {
             found: 7,
-            supported: 1
+            supported: 2
         }
     ));
 
@@ -401,4 +405,34 @@ fn the_checksum_covers_the_new_sections_and_bad_ones_are_refused() {
             "{key} {patch}: {e}"
         );
     }
+}
+
+/// Issue 32 item 7: a section that changes the outputs is required, and a reader that does not
+/// know a required section refuses the file; version 1 files still load.
+#[test]
+fn required_sections_are_listed_and_an_unknown_one_is_refused() {
+    use decoder::model::RestStage;
+    let with_stage = trained(ModelKind::ResDd)
+        .with_rest_stage(Some(RestStage::try_new([0.1; 5], [0.05; 5], 4.0).unwrap()));
+    let bytes = with_stage.to_bytes().unwrap();
+    assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 2);
+    let mut p = split(&bytes);
+    assert_eq!(p.meta["required"], serde_json::json!(["rest_stage"]));
+    let load = |b: &[u8]| TrainedModel::from_bytes(b, Some(&chain(2)));
+    assert!(load(&join(&p)).is_ok());
+    // A newer writer's section this build does not know.
+    p.meta["required"] = serde_json::json!(["rest_stage", "grip_limiter"]);
+    let e = load(&join(&p)).unwrap_err();
+    assert!(
+        matches!(&e, FileError::UnknownRequired { sections } if sections == &["grip_limiter"]),
+        "{e}"
+    );
+    // A version 2 file with a rest stage it does not mark required is malformed.
+    p.meta["required"] = serde_json::json!([]);
+    let e = load(&join(&p)).unwrap_err();
+    assert!(e.to_string().contains("rest_stage"), "{e}");
+    // Version 1 (no `required`): loads, its rest stage applied as before.
+    p.meta.as_object_mut().unwrap().remove("required");
+    let old = load(&join_version(&p, 1)).expect("a version 1 file loads");
+    assert_eq!(old.rest_stage(), with_stage.rest_stage());
 }

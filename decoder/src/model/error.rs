@@ -132,12 +132,22 @@ pub enum FileError {
     #[error("not a handstack model file (bad magic bytes)")]
     NotAModelFile,
     /// The file has a format version this build does not read.
-    #[error("unsupported model file version {found} (this build reads version {supported})")]
+    #[error("unsupported model file version {found} (this build reads versions 1 to {supported})")]
     UnknownVersion {
         /// Version in the file.
         found: u32,
         /// Version this build reads and writes.
         supported: u32,
+    },
+    /// The file marks as required a metadata section this build does not know: it would run
+    /// the model without part of what decides its outputs.
+    #[error(
+        "the model file requires {sections:?}, which this build does not know; use a handd and \
+         handctl as new as the handctl train that wrote it"
+    )]
+    UnknownRequired {
+        /// The unknown required sections.
+        sections: Vec<String>,
     },
     /// The file is shorter or longer than its header says.
     #[error("model file length is wrong: header says {expected} body bytes, found {found}")]

@@ -19,6 +19,17 @@
 //! verified"). Everything in the body, these included, is covered by the checksum. Weights are
 //! raw IEEE-754 doubles so they load bit for bit.
 //!
+//! Versions. Version 2 lists in `required` every metadata section present that changes what
+//! the model outputs (today `rest_stage`, the dead zone at rest); a reader refuses a file whose
+//! `required` names a section it does not know ([`FileError::UnknownRequired`]), so a newer file
+//! is never run with part of its behaviour silently dropped. Sections that only describe the
+//! model (`verification`, `rest_rms_uv`, the summary) are not required: an older reader may
+//! ignore them. A new section that changes the outputs goes into `required` (and this build's
+//! [`KNOWN_REQUIRED`]); a change of the layout itself bumps [`FORMAT_VERSION`]. This build
+//! reads versions 1 (written before `required` existed; its optional sections are read as
+//! before) and 2, and writes 2. A build from before version 2 refuses a version 2 file by its
+//! version, instead of dropping its dead zone as it did with version 1 files that carried one.
+//!
 //! Loading checks, in this order, each with its own [`FileError`]: magic, version, length,
 //! checksum, metadata, tensor shapes against the kind and spec, finite weights, the chain
 //! configuration against the one in use.
@@ -45,8 +56,13 @@ use super::verify::VerificationRecord;
 
 /// Magic bytes at the start of every model file.
 pub const MAGIC: [u8; 8] = *b"HSMODEL\n";
-/// The format version this build writes and reads.
-pub const FORMAT_VERSION: u32 = 1;
+/// The format version this build writes (it reads this one and the ones before it, from
+/// [`OLDEST_VERSION`]).
+pub const FORMAT_VERSION: u32 = 2;
+/// The oldest format version this build reads.
+pub const OLDEST_VERSION: u32 = 1;
+/// The metadata sections this build knows how to apply, of those a file may mark `required`.
+pub const KNOWN_REQUIRED: &[&str] = &["rest_stage"];
 /// Header length in bytes.
 pub const HEADER_LEN: usize = 24;
 /// Name of the normalizer tensor in the metadata and in errors.
@@ -82,6 +98,9 @@ struct Meta {
     /// Absent in older files, and for a model without a rest stage (raw outputs).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     rest_stage: Option<RestStage>,
+    /// The sections present that change the outputs (version 2 on; see the module docs).
+    #[serde(default)]
+    required: Vec<String>,
 }
 
 const FORMAT_NAME: &str = "handstack-model";
@@ -126,14 +145,15 @@ fn check_finite(params: &[f64], tensors: &[TensorInfo]) -> Result<(), FileError>
     Ok(())
 }
 
-/// The body of a file, after checking the header: magic, version, length, checksum.
-fn checked_body(bytes: &[u8]) -> Result<&[u8], FileError> {
+/// The version and the body of a file, after checking the header: magic, version, length,
+/// checksum.
+fn checked_body(bytes: &[u8]) -> Result<(u32, &[u8]), FileError> {
     if bytes.len() < HEADER_LEN || bytes[..8] != MAGIC {
         return Err(FileError::NotAModelFile);
     }
     let word = |r: std::ops::Range<usize>| -> [u8; 4] { bytes[r].try_into().expect("4 bytes") };
     let version = u32::from_le_bytes(word(8..12));
-    if version != FORMAT_VERSION {
+    if !(OLDEST_VERSION..=FORMAT_VERSION).contains(&version) {
         return Err(FileError::UnknownVersion {
             found: version,
             supported: FORMAT_VERSION,
@@ -155,11 +175,11 @@ fn checked_body(bytes: &[u8]) -> Result<&[u8], FileError> {
             computed,
         });
     }
-    Ok(body)
+    Ok((version, body))
 }
 
-/// The body's JSON metadata, and the weight data that follows it.
-fn read_meta(body: &[u8]) -> Result<(Meta, &[u8]), FileError> {
+/// The body's JSON metadata, and the weight data that follows it, for a file of `version`.
+fn read_meta(version: u32, body: &[u8]) -> Result<(Meta, &[u8]), FileError> {
     let malformed = |m: String| FileError::Malformed(m);
     if body.len() < 8 {
         return Err(malformed("body too short for the metadata length".into()));
@@ -180,6 +200,23 @@ fn read_meta(body: &[u8]) -> Result<(Meta, &[u8]), FileError> {
             "format name {:?}, expected {FORMAT_NAME:?}",
             meta.format
         )));
+    }
+    let unknown: Vec<String> = meta
+        .required
+        .iter()
+        .filter(|r| !KNOWN_REQUIRED.contains(&r.as_str()))
+        .cloned()
+        .collect();
+    if !unknown.is_empty() {
+        return Err(FileError::UnknownRequired { sections: unknown });
+    }
+    if meta.rest_stage.is_some() && !meta.required.iter().any(|r| r == "rest_stage") {
+        // Only a version 1 file may carry a rest stage without saying it is required.
+        if version >= 2 {
+            return Err(malformed(
+                "rest_stage present but not listed in required".into(),
+            ));
+        }
     }
     Ok((meta, data))
 }
@@ -363,6 +400,12 @@ impl TrainedModel {
             verification: self.verification.clone(),
             rest_rms_uv: self.rest_rms_uv.clone(),
             rest_stage: self.rest_stage,
+            required: self
+                .rest_stage
+                .is_some()
+                .then(|| "rest_stage".to_owned())
+                .into_iter()
+                .collect(),
         };
         let meta_json =
             serde_json::to_vec_pretty(&meta).map_err(|e| FileError::Malformed(e.to_string()))?;
@@ -388,8 +431,8 @@ impl TrainedModel {
         bytes: &[u8],
         expected_chain: Option<&ChainConfig>,
     ) -> Result<Self, FileError> {
-        let body = checked_body(bytes)?;
-        let (meta, data) = read_meta(body)?;
+        let (version, body) = checked_body(bytes)?;
+        let (meta, data) = read_meta(version, body)?;
         let chain = meta_chain(&meta)?;
         let n_in = FEATURES_PER_CHANNEL * chain.channels;
         let expected = check_shapes(&meta, n_in)?;
