@@ -1,6 +1,7 @@
 //! The deciding side's first half: which faults hold at this tick, and whether the window may
 //! drive the fingers.
 
+use super::rx::{AmpProblem, AMP_STATUS_SILENCE_US};
 use super::Engine;
 use crate::safety::{DaemonState, Fault};
 use crate::units::N_FINGERS;
@@ -15,6 +16,12 @@ impl Engine {
     pub(super) fn evaluate_faults(&mut self, now_us: u64) -> bool {
         if now_us.saturating_sub(self.emg.last_emg_us) > self.settings.emg_silence_us {
             self.raise(now_us, Fault::EmgSilence);
+        }
+        // The amplifier's status fell silent: its last lead-off and saturation flags are stale,
+        // and nothing says the amplifier still runs as the chain expects.
+        if now_us.saturating_sub(self.inputs.last_amp_status_us) > AMP_STATUS_SILENCE_US {
+            self.inputs.amp_problem = Some(AmpProblem::Silent);
+            self.inputs.amp_reports_bad = true;
         }
         if self.emg.take_railed() >= RAIL_LIMIT || self.inputs.amp_reports_bad {
             self.raise(now_us, Fault::SignalQuality);

@@ -14,6 +14,8 @@
 //! path or panics on any frame: every out-of-range value was excluded by validating the
 //! config, so encoding a setpoint cannot fail, and if it ever did the finger gets a safe stop.
 
+#[cfg(test)]
+mod amp_tests;
 mod epoch;
 mod faults;
 mod rx;
@@ -21,6 +23,7 @@ mod swap;
 mod tx;
 
 pub use epoch::{fresh_epoch, fresh_epochs};
+pub use rx::{amp_problem, AmpProblem, AMP_STATUS_SILENCE_US};
 pub use swap::{Hold, ModelSwap};
 
 use decoder::dsp::ChainSettings;
@@ -178,7 +181,7 @@ impl Engine {
         );
         Self {
             emg: rx::EmgIn::new(chain, settings.max_gap_us, now_us),
-            inputs: rx::Inputs::new(),
+            inputs: rx::Inputs::new(now_us),
             predictor,
             hold: Hold::Free,
             samples_used: 0,
@@ -385,7 +388,13 @@ impl Engine {
     pub fn feedback(&self) -> &[Feedback; N_FINGERS] {
         &self.inputs.feedback
     }
-    /// The amplifier's last lead-off and saturation masks (bit c = channel c).
+    /// What the amplifier's own status says is wrong with its samples (it raises
+    /// `signal_quality` while it lasts), if anything.
+    pub fn amp_problem(&self) -> Option<AmpProblem> {
+        self.inputs.amp_problem
+    }
+
+    /// The amplifier's last lead-off and saturation masks.
     pub fn amp_masks(&self) -> (u16, u16) {
         self.inputs.amp_masks
     }

@@ -6,7 +6,8 @@ use decoder::dsp::{Chain, ChainSettings};
 use hand_dbc::e2e::{E2eChecker, E2eProfile, E2eStatus};
 use hand_dbc::emg_front::{EmgFront, EmgFrontConfig, EmgFrontSettings, FrameVerdict};
 use hand_dbc::messages::{
-    self, AmpState, EmgStatus, EstopRequest, FingerState, FingerStatus, HandEstop, Message,
+    self, AmpSampleRate, AmpState, EmgStatus, EstopRequest, FingerState, FingerStatus, HandEstop,
+    Message,
 };
 use hand_dbc::CanFrame;
 
@@ -131,6 +132,77 @@ pub(super) struct Inputs {
     pub(super) feedback: [Feedback; N_FINGERS],
     /// The amplifier's last lead-off and saturation masks (bit c = channel c).
     pub(super) amp_masks: (u16, u16),
+    /// Receive time of the last valid EMG_STATUS (the engine's start before the first one).
+    pub(super) last_amp_status_us: u64,
+    /// What the amplifier's last status says is wrong with its samples, if anything.
+    pub(super) amp_problem: Option<AmpProblem>,
+}
+
+/// EMG_STATUS at 10 Hz: three missed in a row (300 ms) is a silence, and the lead-off and
+/// saturation flags of the last one can no longer be trusted.
+pub const AMP_STATUS_SILENCE_US: u64 = 300_000;
+
+/// EMG_STATUS fault bits that make the samples unusable (hand.dbc): ADC, supply,
+/// over-temperature, clock. Bit 4 (transmit overrun) is not one: the samples it dropped are
+/// counted and bridged or faulted by the front end like any other loss.
+const AMP_FAULT_BITS: u8 = 0x0F;
+
+/// Why the amplifier's own status says its samples cannot drive the hand.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AmpProblem {
+    /// Not RUNNING (samples are only meaningful while RUNNING, hand.dbc).
+    State(AmpState),
+    /// Sampling at another rate than the chain runs, Hz.
+    Rate {
+        /// The amplifier's rate.
+        amplifier_hz: u32,
+        /// The chain's.
+        chain_hz: u32,
+    },
+    /// A fault bit (ADC, supply, over-temperature, clock).
+    Fault(u8),
+    /// No EMG_STATUS for [`AMP_STATUS_SILENCE_US`].
+    Silent,
+}
+
+impl std::fmt::Display for AmpProblem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            AmpProblem::State(s) => write!(f, "the amplifier is {s:?}, not RUNNING"),
+            AmpProblem::Rate {
+                amplifier_hz,
+                chain_hz,
+            } => write!(
+                f,
+                "the amplifier samples at {amplifier_hz} Hz, the signal chain runs at {chain_hz} Hz"
+            ),
+            AmpProblem::Fault(bits) => write!(f, "the amplifier reports fault bits {bits:#04x}"),
+            AmpProblem::Silent => {
+                write!(f, "no EMG_STATUS for {} ms", AMP_STATUS_SILENCE_US / 1000)
+            }
+        }
+    }
+}
+
+/// The problem an EMG_STATUS reports for a chain sampling at `chain_hz`, if any.
+pub fn amp_problem(st: &EmgStatus, chain_hz: u32) -> Option<AmpProblem> {
+    let amplifier_hz = match st.sample_rate() {
+        AmpSampleRate::Sr500Hz => 500,
+        AmpSampleRate::Sr1000Hz => 1000,
+        AmpSampleRate::Sr2000Hz => 2000,
+    };
+    if st.state() != AmpState::Running {
+        Some(AmpProblem::State(st.state()))
+    } else if amplifier_hz != chain_hz {
+        Some(AmpProblem::Rate {
+            amplifier_hz,
+            chain_hz,
+        })
+    } else if st.faults() & AMP_FAULT_BITS != 0 {
+        Some(AmpProblem::Fault(st.faults() & AMP_FAULT_BITS))
+    } else {
+        None
+    }
 }
 
 fn checker(profile: E2eProfile, max_delta: u16) -> E2eChecker {
@@ -138,7 +210,7 @@ fn checker(profile: E2eProfile, max_delta: u16) -> E2eChecker {
 }
 
 impl Inputs {
-    pub(super) fn new() -> Self {
+    pub(super) fn new(now_us: u64) -> Self {
         Self {
             status: FingerStatus::E2E.map(|p| checker(p, 3)),
             estop: checker(HandEstop::E2E, 15),
@@ -148,6 +220,8 @@ impl Inputs {
             reported_position: [0.0; N_FINGERS],
             feedback: [Feedback::default(); N_FINGERS],
             amp_masks: (0, 0),
+            last_amp_status_us: now_us,
+            amp_problem: None,
         }
     }
 }
@@ -209,9 +283,12 @@ impl Engine {
             Message::EmgStatus(st) => match self.inputs.amp_status.check(Some(data)) {
                 E2eStatus::Ok | E2eStatus::WrongSequence => {
                     self.inputs.amp_masks = (st.lead_off_mask(), st.saturation_mask());
+                    self.inputs.last_amp_status_us = rx_us;
+                    self.inputs.amp_problem =
+                        amp_problem(st, self.emg.chain.settings().sample_rate_hz() as u32);
                     self.inputs.amp_reports_bad = st.lead_off_mask() != 0
                         || st.saturation_mask() != 0
-                        || st.state() == AmpState::Fault;
+                        || self.inputs.amp_problem.is_some();
                 }
                 E2eStatus::Error => self.e2e_error(rx_us),
                 _ => {}
