@@ -28,10 +28,12 @@ fn last_setpoint(r: &Rig, f: usize) -> FingerSetpoint {
 }
 
 /// An ACTIVE setpoint of `epoch` for `FINGER`, with the alive counter after handd's last one
-/// and the right CRC: the controller's E2E check accepts it.
+/// and the right CRC: the controller's E2E check accepts it. Its force (20 N) has the sign of
+/// `velocity`: a controller moves only when they agree.
 fn inject(r: &mut Rig, epoch: u16, velocity: f64) {
     let last = last_setpoint(r, FINGER);
-    let mut frame = FingerSetpoint::new(FINGER, FingerMode::Active, 20.0, velocity, epoch)
+    let force = 20.0_f64.copysign(velocity);
+    let mut frame = FingerSetpoint::new(FINGER, FingerMode::Active, force, velocity, epoch)
         .expect("in range")
         .to_frame();
     let counter = (last.counter() + 1) & 0x0F;

@@ -142,8 +142,10 @@ fn good_setpoints_never_brake_and_motion_stays_in_range() {
     );
     for s in &statuses[1..] {
         assert_ne!(s.state(), FingerState::Braked);
+        // Within the joint range, widened by the stops' small overtravel.
+        let over = cfg.max_overtravel_rad() + 1e-3;
         assert!(
-            s.position() >= cfg.angle_min_rad - 1e-3 && s.position() <= cfg.angle_max_rad + 1e-3
+            s.position() >= cfg.angle_min_rad - over && s.position() <= cfg.angle_max_rad + over
         );
         assert!(s.velocity().abs() <= cfg.max_velocity_rad_s + 0.01);
         assert!(
@@ -152,11 +154,26 @@ fn good_setpoints_never_brake_and_motion_stays_in_range() {
         );
     }
     let last = statuses.last().expect("statuses");
+    // Pressed into the flexion stop by the full 20 N: 120 rad/s² / 25,000 /s² = 4.8 mrad.
+    let press = cfg.max_accel_rad_s2 / cfg.stop_stiffness_per_s2;
     assert!(
-        (last.position() - cfg.angle_max_rad).abs() < 2e-3,
-        "reached full flexion"
+        (last.position() - cfg.angle_max_rad - press).abs() < 2e-3,
+        "reached full flexion: {}",
+        last.position()
     );
     assert!(last.faults() & (1 << 5) != 0, "joint limit reported");
+    // 30 N and 10 rad/s exceed the motor's 20 N and 6 rad/s: saturated and counted on every
+    // control tick after the opening SAFE_STOP.
+    let st = mc.motion_stats();
+    assert!(
+        st.over_force_ticks > 1900 && st.over_speed_ticks > 1900,
+        "{st:?}"
+    );
+    assert_eq!(
+        (st.max_force_requested_n, st.max_speed_requested_rad_s),
+        (30.0, 10.0)
+    );
+    assert_eq!(st.impacts, 1, "one run into the flexion stop");
 }
 
 #[test]
@@ -234,12 +251,122 @@ fn resumes_only_in_a_new_epoch_after_a_timeout_and_obeys_estop_release() {
         stale_flagged,
         "ignored stale-epoch setpoints are reported (fault bit 6)"
     );
-    assert_eq!(mc.epoch_gate().bound(), Some(1), "bound to the new epoch");
+    assert_eq!(
+        mc.epoch_gate().retired(),
+        Some(1),
+        "bound to the new epoch, which the E-stop then retired"
+    );
     assert_eq!(
         state_at(1_150_000),
         FingerState::Active,
         "recovered on a SAFE_STOP of a new epoch and ACTIVE after it"
     );
     assert_eq!(state_at(1_500_000), FingerState::Braked, "E-stop latched");
-    assert_eq!(state_at(1_900_000), FingerState::Active, "released");
+    // The setpoints go on in the retired epoch: ignored, they feed no watchdog, so the
+    // released controller is braked by itself again, never ACTIVE.
+    assert_eq!(
+        state_at(1_900_000),
+        FingerState::Braked,
+        "released: the old command is not resumed"
+    );
+}
+
+/// An E-stop retires the epoch like braking by itself: a STOP and a RELEASE 10 ms later (inside
+/// one 20 ms status period, shorter than handd's tick) resume nothing; the finger moves again
+/// only after a SAFE_STOP of a new epoch and an ACTIVE after it.
+#[test]
+fn a_short_estop_resumes_nothing_until_a_new_epoch() {
+    use embedded_can::nb::Can;
+    use hand_dbc::messages::{EstopReason, EstopRequest, EstopSource, HandEstop};
+    use hand_model::dbc::seal;
+
+    let mut h = Harness::new();
+    let mut mc_ep = h.bus.endpoint();
+    let mut sp_ep = h.bus.endpoint();
+    let mut tool_ep = h.bus.endpoint();
+    let mut mc = FingerNode::try_new(FINGER, FingerConfig::default(), 0).expect("valid");
+    let mut sp = SetpointSource::try_new(FINGER, 0).expect("valid");
+    sp.set(FingerMode::Active, 5.0, 0.5).expect("in range");
+    let estop = |req: EstopRequest, counter: u8| {
+        let mut f = HandEstop::new(req, EstopSource::Tool, EstopReason::Technician)
+            .expect("valid")
+            .to_frame();
+        seal(&mut f, HandEstop::E2E, counter, false);
+        f
+    };
+    // (time, angle) every millisecond.
+    let mut angles = Vec::new();
+    h.run(1_000_000, |t| {
+        match t {
+            300_000 => {
+                tool_ep
+                    .transmit(&estop(EstopRequest::Stop, 0))
+                    .expect("sent");
+            }
+            310_000 => {
+                tool_ep
+                    .transmit(&estop(EstopRequest::Release, 1))
+                    .expect("sent");
+            }
+            700_000 => sp.new_epoch(),
+            _ => {}
+        }
+        sp.poll(t, &mut sp_ep);
+        mc.poll(t, &mut mc_ep);
+        angles.push((t, mc.physics().angle_rad));
+    });
+    let angle_at = |t0: u64| {
+        angles
+            .iter()
+            .find(|(t, _)| *t == t0)
+            .map(|(_, a)| *a)
+            .expect("sampled")
+    };
+    assert!(
+        angle_at(300_000) > angle_at(200_000) + 0.04,
+        "moving before the stop"
+    );
+    let stopped = angle_at(300_000);
+    assert!(
+        angles
+            .iter()
+            .filter(|(t, _)| (300_000..=700_000).contains(t))
+            .all(|(_, a)| *a == stopped),
+        "the finger moved after the RELEASE, before a new epoch"
+    );
+    let statuses: Vec<(u64, FingerStatus)> = h
+        .with_id(FingerStatus::IDS[FINGER])
+        .into_iter()
+        .map(|(t, f)| {
+            (
+                t,
+                FingerStatus::decode(f.raw_id(), f.data()).expect("valid"),
+            )
+        })
+        .collect();
+    let during = |lo: u64, hi: u64| statuses.iter().filter(move |(t, _)| (lo..hi).contains(t));
+    assert!(during(301_000, 310_000).all(|(_, s)| s.state() == FingerState::Braked));
+    // Released: stopped, not braked; 150 ms after the last frame it followed (250 ms: the
+    // old epoch's frames since are ignored and feed no watchdog) it brakes by itself; never
+    // is it ACTIVE.
+    assert!(during(320_000, 390_000).all(|(_, s)| s.state() == FingerState::SafeStop));
+    assert!(during(320_000, 700_000)
+        .all(|(_, s)| matches!(s.state(), FingerState::SafeStop | FingerState::Braked)));
+    assert!(
+        during(320_000, 700_000).any(|(_, s)| s.faults() & (1 << 6) != 0),
+        "the old epoch's ACTIVE setpoints are ignored and reported (fault bit 6)"
+    );
+    assert_eq!(
+        mc.epoch_gate().retired(),
+        Some(0),
+        "the E-stop retired epoch 0"
+    );
+    assert!(
+        angle_at(1_000_000) > stopped + 0.05,
+        "moves again after a SAFE_STOP of epoch 1 and an ACTIVE"
+    );
+    assert_eq!(
+        statuses.last().expect("status").1.state(),
+        FingerState::Active
+    );
 }

@@ -282,6 +282,22 @@ fn run_realtime<B: Bus>(mut world: World<B>, duration_us: u64) {
         std::thread::sleep(Duration::from_micros(1000 - now % 1000));
     }
     eprintln!("handsim: done; {} frames sent", world.frames_sent());
+    for f in world.fingers() {
+        let m = f.motion_stats();
+        eprintln!(
+            "handsim: finger {}: {} stop impacts (fastest {:.2} rad/s, overtravel {:.1} mrad); \
+commands over the limits on {} ticks (force, largest {:.1} N) and {} ticks (speed, largest \
+{:.2} rad/s)",
+            f.finger(),
+            m.impacts,
+            m.max_impact_speed_rad_s,
+            m.max_overtravel_rad * 1e3,
+            m.over_force_ticks,
+            m.max_force_requested_n,
+            m.over_speed_ticks,
+            m.max_speed_requested_rad_s
+        );
+    }
     if let Some(amp) = world.amplifier() {
         let st = amp.stats();
         eprintln!(

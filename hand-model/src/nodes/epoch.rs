@@ -12,7 +12,7 @@
 //!   not change the command nor feed the setpoint watchdog.
 //!
 //! At power-up the controller is bound to none and has retired none. When it brakes by itself
-//! (setpoint timeout) it retires its epoch and is bound to none: it moves again only after a
+//! (setpoint timeout) or on a HAND_ESTOP STOP it retires its epoch and is bound to none: it moves again only after a
 //! SAFE_STOP of a new epoch. Epochs are compared for equality only, so their counter wraps
 //! freely (handd steps it by one modulo 2^16).
 
@@ -78,8 +78,8 @@ impl EpochGate {
         }
     }
 
-    /// The controller braked by itself (setpoint timeout): its epoch is retired and it is bound
-    /// to none.
+    /// The controller braked by itself (setpoint timeout) or on a HAND_ESTOP STOP: its epoch
+    /// is retired and it is bound to none.
     pub fn braked_by_itself(&mut self) {
         if self.bound.is_some() {
             self.retired = self.bound.take();

@@ -6,11 +6,15 @@
 //! counter or a counter jump does not, and raises the E2E fault bit. When no valid setpoint
 //! arrived for `setpoint_timeout_us` (150 ms), the brake engages: velocity and force go to
 //! zero at once, the state becomes BRAKED and fault bit 3 is set, so a killed daemon leaves a
-//! safe hand. A valid HAND_ESTOP STOP also brakes, until a valid RELEASE.
+//! safe hand. A valid HAND_ESTOP STOP also brakes (reported BRAKED, without bit 3) and, on
+//! its first frame, retires the epoch and replaces the command with SAFE_STOP, as braking by
+//! itself does: a RELEASE only lifts the brake, and the finger stays stopped (SAFE_STOP) until
+//! a SAFE_STOP of a new epoch and an ACTIVE after it arrive. The repetitions of a STOP (every
+//! 10 ms) retire nothing more, so the new epoch handd opens while the stop lasts stays bound.
 //!
 //! A setpoint that passed E2E is then judged by its epoch ([`super::epoch`]): the controller
 //! follows it only in the epoch it is bound to, which a SAFE_STOP opens; one it ignores sets
-//! fault bit 6 and feeds no watchdog. So after braking by itself (which retires its epoch)
+//! fault bit 6 and feeds no watchdog. So after braking by itself or an E-stop (which retire its epoch)
 //! the controller moves again only after a SAFE_STOP of a new epoch (the first frame after a
 //! gap resynchronises the E2E counter, so it takes that frame and the SAFE_STOP after it).
 
@@ -23,7 +27,9 @@ use super::{std_id, Bus, NodeStats};
 use crate::dbc::seal;
 use crate::error::SimError;
 use crate::faults::{CrcTarget, Fault, FaultPlan};
-use crate::finger::{Command, FingerConfig, FingerMode, FingerPhysics, FingerState, N_FINGERS};
+use crate::finger::{
+    Command, FingerConfig, FingerMode, FingerPhysics, FingerState, MotionStats, N_FINGERS,
+};
 
 /// FINGER_STATUS fault bit 3: setpoint timeout, braked.
 pub const FAULT_SETPOINT_TIMEOUT: u8 = 1 << 3;
@@ -131,6 +137,11 @@ impl FingerNode {
         self.estop || self.timed_out || !self.ever_valid
     }
 
+    /// Impacts on the joint stops and commands beyond the motor's limits so far.
+    pub fn motion_stats(&self) -> MotionStats {
+        self.phys.stats
+    }
+
     /// Setpoints rejected by the E2E check so far.
     pub fn e2e_errors(&self) -> u64 {
         self.e2e_errors
@@ -217,7 +228,18 @@ impl FingerNode {
             let data = frame.data();
             let crc_ok = data.len() == HandEstop::DLC && data[0] == HandEstop::E2E.crc(data);
             if let (true, Ok(e)) = (crc_ok, HandEstop::decode(data)) {
-                self.estop = e.request() == EstopRequest::Stop;
+                let stop = e.request() == EstopRequest::Stop;
+                if stop && !self.estop {
+                    // As when it brakes by itself: the epoch is retired and the command
+                    // forgotten, so a RELEASE resumes nothing.
+                    self.gate.braked_by_itself();
+                    self.cmd = Command {
+                        mode: FingerMode::SafeStop,
+                        force_n: 0.0,
+                        velocity_rad_s: 0.0,
+                    };
+                }
+                self.estop = stop;
             }
         }
     }
