@@ -122,6 +122,9 @@ pub struct DemoReport {
     /// Per finger, the time its controller reported being at a joint stop with the command
     /// pushing into it (FINGER_STATUS fault bit 5) over the scored time, s.
     pub at_stop_s: [f64; N_FINGERS],
+    /// Per finger, the entries into a joint stop over the whole tracking (the simulated
+    /// controller counts them) and the fastest, rad/s.
+    pub impacts: [(u64, f64); N_FINGERS],
     /// The daemon's snapshot at the end (latency, deadline misses, ...).
     pub end: Snapshot,
 }
@@ -310,6 +313,7 @@ pub fn run_demo(
             motion.abs_velocity[f] / motion.setpoints.max(1) as f64
         }),
         at_stop_s: motion.at_stop_s,
+        impacts: motion.impacts,
         end,
     })
 }
@@ -442,6 +446,8 @@ struct Motion {
     abs_velocity: [f64; N_FINGERS],
     /// Seconds at a joint stop per finger (FINGER_STATUS bit 5, one status period each).
     at_stop_s: [f64; N_FINGERS],
+    /// Impacts into a joint stop per finger, and the fastest.
+    impacts: [(u64, f64); N_FINGERS],
 }
 
 /// The tracking phase's record.
@@ -543,6 +549,10 @@ fn track<K: DemoClock>(
                 tracked,
             });
         }
+    }
+    for (f, finger) in world.fingers().enumerate().take(N_FINGERS) {
+        let m = finger.motion_stats();
+        motion.impacts[f] = (m.impacts, m.max_impact_speed_rad_s);
     }
     let snap = *runner.snapshot().lock().unwrap_or_else(|e| e.into_inner());
     Ok((Tracked { samples, motion }, snap))

@@ -97,7 +97,11 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
     println!(
         "output law {:?}: {}",
         a.law,
-        motion(&report.mean_abs_velocity, &report.at_stop_s)
+        motion(
+            &report.mean_abs_velocity,
+            &report.at_stop_s,
+            &report.impacts
+        )
     );
     println!(
         "daemon: latency p50 {} us p99 {} us, compute p50 {} us p99 {} us, deadline misses {}, state {}",
@@ -122,18 +126,19 @@ fn selectivity(mean_abs_label: &[f64; 5]) -> String {
     )
 }
 
-/// The output law's line: per finger, the mean |velocity setpoint| and the time at a joint stop.
-fn motion(mean_abs_velocity: &[f64; 5], at_stop_s: &[f64; 5]) -> String {
+/// The output law's line: per finger, the mean |velocity setpoint|, the time at a joint stop,
+/// and the impacts into a stop with the fastest.
+fn motion(mean_abs_velocity: &[f64; 5], at_stop_s: &[f64; 5], impacts: &[(u64, f64); 5]) -> String {
     let fingers: Vec<String> = (0..5)
         .map(|f| {
             format!(
-                "{} {:.2} rad/s, {:.1} s",
-                FINGER_NAMES[f], mean_abs_velocity[f], at_stop_s[f]
+                "{} {:.2} rad/s, {:.1} s, {} at <= {:.2} rad/s",
+                FINGER_NAMES[f], mean_abs_velocity[f], at_stop_s[f], impacts[f].0, impacts[f].1
             )
         })
         .collect();
     format!(
-        "mean |velocity setpoint| and time at a joint stop per finger: {}",
+        "per finger: mean |velocity setpoint|, time at a joint stop, impacts into a stop: {}",
         fingers.join(", ")
     )
 }

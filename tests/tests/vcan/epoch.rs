@@ -52,8 +52,15 @@ fn next_handd_setpoint(reader: &CanSocket) -> FingerSetpoint {
 /// c + 1 and the right CRC: E2E accepts it. Returns when it was written.
 fn inject_after(reader: &CanSocket, w: &CanSocket, epoch: u16, velocity: f64) -> u64 {
     let handd = next_handd_setpoint(reader);
-    let sp =
-        FingerSetpoint::new(FINGER, FingerMode::Active, 20.0, velocity, epoch).expect("in range");
+    // Force of the velocity's sign: the controller moves only when the two agree (hand.dbc).
+    let sp = FingerSetpoint::new(
+        FINGER,
+        FingerMode::Active,
+        20.0_f64.copysign(velocity),
+        velocity,
+        epoch,
+    )
+    .expect("in range");
     let mut frame = sp.to_frame();
     seal(
         &mut frame,
