@@ -16,7 +16,7 @@ use hand_dbc::CanFrame;
 
 use crate::bus_load::BusLoad;
 use crate::conditioner::{FingerGains, Setpoint};
-use crate::engine::{Command, Counters, Engine};
+use crate::engine::{AmpProblem, Command, Counters, Engine};
 use crate::safety::{DaemonState, Fault, FaultSet, FingerEvent};
 use crate::stats::Percentiles;
 use crate::transport::{BusHealth, ControllerState, Transport, TransportError};
@@ -184,6 +184,8 @@ pub struct Runner<T: Transport, K: Clock> {
     carried: bool,
     failure_log: LogLimit,
     reopen_log: LogLimit,
+    /// The amplifier's status problem last logged.
+    amp_problem: Option<AmpProblem>,
 }
 
 impl<T: Transport, K: Clock> Runner<T, K> {
@@ -213,6 +215,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             carried: true,
             failure_log: LogLimit::default(),
             reopen_log: LogLimit::default(),
+            amp_problem: None,
         }
     }
 
@@ -467,6 +470,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
                 FingerEvent::Enabled(f) => tracing::info!(finger = FINGER_NAMES[f], "finger controller back: finger enabled"),
             },
         );
+        self.log_amp_problem();
         self.publish(deadline);
         self.next_deadline_us += self.tick_us;
         // After a long stall, skip the missed ticks rather than run them back to back.
@@ -474,6 +478,22 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             let behind = (t1 - self.next_deadline_us) / self.tick_us;
             self.next_deadline_us += behind * self.tick_us;
         }
+    }
+
+    /// Names a change of what the amplifier's status says (logged once per change, not per
+    /// tick).
+    fn log_amp_problem(&mut self) {
+        let now = self.engine.amp_problem();
+        if now == self.amp_problem {
+            return;
+        }
+        match now {
+            Some(p) => {
+                tracing::warn!(problem = %p, "amplifier: its samples cannot drive the hand (signal_quality)")
+            }
+            None => tracing::info!("amplifier: status good again"),
+        }
+        self.amp_problem = now;
     }
 
     /// At most [`MAX_COMMANDS_PER_TICK`] waiting commands, at the tick's deadline.

@@ -59,7 +59,9 @@ pub enum Fault {
     /// NaN or infinity in the chain or the model output.
     NonFinite,
     /// A channel at the ADC rail (saturation, or lead-off picking up mains), from the samples
-    /// themselves or from EMG_STATUS.
+    /// themselves or from EMG_STATUS; or the amplifier's own status says its samples cannot
+    /// drive the hand: not RUNNING, at another rate than the chain, a fault bit, or no
+    /// EMG_STATUS for 300 ms (the log names which).
     SignalQuality,
     /// A HAND_ESTOP frame arrived.
     EStop,
