@@ -385,6 +385,11 @@ mod tests {
         assert!(Fault::SecondMaster.is_latched());
         assert_eq!(Fault::SecondMaster.name(), "second_master");
         assert_eq!(Fault::SecondMaster.bit(), 1 << 14);
+        // Whatever the frame holds: a wrong length or CRC does not make it handd's own.
+        let mut e = engine();
+        let short = CanFrame::new_standard(FingerSetpoint::IDS[4] as u16, &[0; 3]).expect("frame");
+        e.on_frame(&short, 2_000);
+        assert!(e.faults().contains(Fault::SecondMaster));
     }
 
     #[test]
