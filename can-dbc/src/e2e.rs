@@ -7,9 +7,24 @@
 //! is never sent, a frame that is correct for one message is rejected when it arrives under
 //! another id (a corrupted id, or a sender mixing up buffers).
 //!
+//! That holds only if no two protected messages of one length leave the CRC register in the
+//! same state after their data ids: the data id reaches the CRC only through that 8-bit
+//! register, so two such messages compute the same CRC over every payload (17 ids in 256
+//! registers collide more often than not). The code generator therefore refuses hand.dbc when
+//! two protected messages of equal length share the register, whatever their counter widths;
+//! unequal registers give unequal CRCs for every payload, and unequal lengths fail the length
+//! check. `cargo test -p hand-dbc-codegen --test refusals e2e_register_table -- --nocapture`
+//! prints the table.
+//!
 //! The receiver side follows AUTOSAR E2E Profile 1: [`E2eChecker::check`] classifies each
-//! reception as [`E2eStatus::Ok`], [`E2eStatus::Repeated`], [`E2eStatus::WrongSequence`],
-//! [`E2eStatus::Error`] or [`E2eStatus::NoNewData`].
+//! reception as [`E2eStatus::Ok`], [`E2eStatus::Sync`], [`E2eStatus::Repeated`],
+//! [`E2eStatus::WrongSequence`], [`E2eStatus::Error`] or [`E2eStatus::NoNewData`]. With
+//! [`E2eCheckConfig::profile1`] a wrong sequence (a counter jump, or a repeat) is followed by a
+//! resynchronisation: [`E2eCheckConfig::sync_counter`] consecutive in-sequence frames (default
+//! 2) are reported `Sync` before the data is used again, so a single stray frame, a replay or a
+//! second sender interleaving with the real one cannot slip data in right after it. Only `Ok`
+//! means "use the data". [`E2eChecker::try_new`] builds a checker without that phase
+//! ([`E2eCheckConfig::resync_at_once`]) for streams that must act on every correct frame.
 
 use crate::frame::CanFrame;
 
@@ -306,12 +321,19 @@ pub trait Protected {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum E2eStatus {
     /// CRC correct and the counter advanced by 1..=allowed delta (lost frames in between are
-    /// counted, see [`E2eChecker::lost_frames`]); also the first correct frame after start.
+    /// counted, see [`E2eChecker::lost_frames`]), no resynchronisation pending; also the first
+    /// correct frame after start. The data may be used.
     Ok,
-    /// CRC correct but the counter did not change: the same frame again.
+    /// CRC correct and the counter in sequence, but the stream is still resynchronising after
+    /// a wrong sequence or too many repeated/empty receptions (Profile 1's SYNC): the data must
+    /// not be used yet. See [`E2eCheckConfig::sync_counter`].
+    Sync,
+    /// CRC correct but the counter did not change: the same frame again. Counts against
+    /// [`E2eCheckConfig::max_no_new_or_repeated`].
     Repeated,
-    /// CRC correct but the counter jumped further than allowed (too many frames lost, or a
-    /// stale sender). The counter becomes the new reference, so the stream resynchronises.
+    /// CRC correct but the counter jumped further than allowed (too many frames lost, a stale
+    /// sender, or a second sender). The counter becomes the new reference and the next
+    /// [`E2eCheckConfig::sync_counter`] in-sequence frames are [`E2eStatus::Sync`].
     WrongSequence,
     /// Wrong CRC (corruption, or a frame of another message) or wrong length.
     Error,
@@ -319,32 +341,100 @@ pub enum E2eStatus {
     NoNewData,
 }
 
-/// Receiver side: classifies each reception of one message stream.
+/// The receiver's parameters, as AUTOSAR E2E Profile 1 names them: MaxDeltaCounterInit,
+/// SyncCounterInit and MaxNoNewOrRepeatedData. Validated once by [`E2eChecker::with_config`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct E2eCheckConfig {
+    /// Largest counter step accepted as in sequence (1 = no loss tolerated; at most
+    /// modulus - 1). Each reception without usable new data (nothing, a repeat, a wrong CRC)
+    /// widens the next allowed step by one, since the sender kept counting.
+    pub max_delta_counter: u16,
+    /// In-sequence frames needed after a wrong sequence before the data is used again: that
+    /// many frames are reported [`E2eStatus::Sync`], the one after is [`E2eStatus::Ok`].
+    /// 0 accepts the first in-sequence frame after a jump (the reference moves at once).
+    pub sync_counter: u8,
+    /// Receptions with a repeated counter (or checks with no new data) tolerated between two
+    /// in-sequence frames; one more and the stream resynchronises as after a jump: the next
+    /// `sync_counter` in-sequence frames are [`E2eStatus::Sync`]. `u16::MAX` turns the rule
+    /// off. A receiver that calls `check(None)` on every cycle without a frame must
+    /// allow the cycles it may miss.
+    pub max_no_new_or_repeated: u16,
+}
+
+impl E2eCheckConfig {
+    /// Default [`Self::sync_counter`]: two in-sequence frames before data is used again. One
+    /// frame in sequence proves little (a stray sender hits the next counter with a chance of
+    /// 1 in 16 on a 4-bit counter); two consecutive ones, 1 in 256, while a 50 Hz status
+    /// stream loses only 40 ms to a resynchronisation.
+    pub const DEFAULT_SYNC_COUNTER: u8 = 2;
+    /// Default [`Self::max_no_new_or_repeated`]: none. A receiver that checks on reception
+    /// only never calls `check(None)`, and a repeated counter is a wrong sequence: CAN does not
+    /// deliver a frame twice in normal operation, so a repeat is a replay or a second sender.
+    pub const DEFAULT_MAX_NO_NEW_OR_REPEATED: u16 = 0;
+
+    /// Profile 1 with the defaults above and `max_delta_counter`.
+    pub const fn profile1(max_delta_counter: u16) -> Self {
+        Self {
+            max_delta_counter,
+            sync_counter: Self::DEFAULT_SYNC_COUNTER,
+            max_no_new_or_repeated: Self::DEFAULT_MAX_NO_NEW_OR_REPEATED,
+        }
+    }
+
+    /// No resynchronisation phase: a jump moves the reference and the next in-sequence frame
+    /// is `Ok`; repeats are only reported. For streams whose consumer handles jumps itself
+    /// (the EMG front end bridges gaps by the counter) or must act on every correct frame
+    /// whatever its counter (HAND_ESTOP, whose senders interleave counters).
+    pub const fn resync_at_once(max_delta_counter: u16) -> Self {
+        Self {
+            max_delta_counter,
+            sync_counter: 0,
+            max_no_new_or_repeated: u16::MAX,
+        }
+    }
+}
+
+/// Receiver side: classifies each reception of one message stream, following the check state
+/// machine of AUTOSAR E2E Profile 1 (with the reference counter moved on a wrong sequence, as
+/// the profile does when its sync counter is in use).
 #[derive(Debug, Clone)]
 pub struct E2eChecker {
     profile: E2eProfile,
-    max_delta: u16,
+    config: E2eCheckConfig,
     last_counter: Option<u8>,
-    no_new_data: u16,
+    /// Receptions since the last in-sequence frame that widen the allowed step.
+    widen: u16,
+    /// Profile 1's NoNewOrRepeatedDataCounter.
+    no_new_or_repeated: u16,
+    /// Profile 1's SyncCounter: in-sequence frames still to be reported as `Sync`.
+    sync_left: u8,
     lost_frames: u64,
 }
 
 impl E2eChecker {
-    /// A checker that accepts counter steps of up to `max_delta_counter` (1 = no loss
-    /// tolerated; at most modulus - 1).
+    /// A checker without a resynchronisation phase ([`E2eCheckConfig::resync_at_once`]) that
+    /// accepts counter steps of up to `max_delta_counter` (1 = no loss tolerated; at most
+    /// modulus - 1).
     pub fn try_new(profile: E2eProfile, max_delta_counter: u16) -> Result<Self, E2eError> {
+        Self::with_config(profile, E2eCheckConfig::resync_at_once(max_delta_counter))
+    }
+
+    /// A checker with `config`, validated here: the max delta must be in 1..=modulus - 1.
+    pub fn with_config(profile: E2eProfile, config: E2eCheckConfig) -> Result<Self, E2eError> {
         let max = profile.counter_modulus() - 1;
-        if max_delta_counter == 0 || max_delta_counter > max {
+        if config.max_delta_counter == 0 || config.max_delta_counter > max {
             return Err(E2eError::MaxDelta {
-                value: max_delta_counter,
+                value: config.max_delta_counter,
                 max,
             });
         }
         Ok(Self {
             profile,
-            max_delta: max_delta_counter,
+            config,
             last_counter: None,
-            no_new_data: 0,
+            widen: 0,
+            no_new_or_repeated: 0,
+            sync_left: 0,
             lost_frames: 0,
         })
     }
@@ -352,6 +442,11 @@ impl E2eChecker {
     /// The profile in use.
     pub fn profile(&self) -> E2eProfile {
         self.profile
+    }
+
+    /// The receiver parameters in use.
+    pub fn config(&self) -> E2eCheckConfig {
+        self.config
     }
 
     /// Frames skipped inside accepted counter steps since start.
@@ -362,45 +457,68 @@ impl E2eChecker {
     /// Forgets the reference counter: the next correct frame is accepted as the first.
     pub fn reset(&mut self) {
         self.last_counter = None;
-        self.no_new_data = 0;
+        self.widen = 0;
+        self.no_new_or_repeated = 0;
+        self.sync_left = 0;
     }
 
     /// Classifies one reception: `Some(payload)` for a received frame, `None` when the
-    /// receiver's cycle found nothing new. As in AUTOSAR Profile 1, every `None` widens the
-    /// allowed counter step of the next frame by one (up to modulus - 1), since the sender
-    /// kept counting while nothing arrived.
+    /// receiver's cycle found nothing new. Every reception without usable new data (`None`, a
+    /// repeat, a wrong CRC) widens the allowed counter step of the next frame by one (up to
+    /// modulus - 1), since the sender kept counting. Only [`E2eStatus::Ok`] means the data may
+    /// be used.
     #[inline]
     pub fn check(&mut self, data: Option<&[u8]>) -> E2eStatus {
         let Some(data) = data else {
-            self.no_new_data = self.no_new_data.saturating_add(1);
+            self.widen = self.widen.saturating_add(1);
+            self.no_new_or_repeated = self.no_new_or_repeated.saturating_add(1);
             return E2eStatus::NoNewData;
         };
         if data.len() != self.profile.dlc() || data[0] != self.profile.crc(data) {
+            self.widen = self.widen.saturating_add(1);
             return E2eStatus::Error;
         }
         let counter = self.profile.counter(data);
         let Some(last) = self.last_counter else {
             self.last_counter = Some(counter);
-            self.no_new_data = 0;
+            self.widen = 0;
+            self.no_new_or_repeated = 0;
+            self.sync_left = 0;
             return E2eStatus::Ok;
         };
         // The step modulo 16 or 256: both counters are masked to the width.
         let delta = u16::from(counter.wrapping_sub(last) & self.profile.counter_mask());
-        let allowed = self
-            .max_delta
-            .saturating_add(self.no_new_data)
-            .min(self.profile.counter_modulus() - 1);
         if delta == 0 {
+            self.widen = self.widen.saturating_add(1);
+            self.no_new_or_repeated = self.no_new_or_repeated.saturating_add(1);
             return E2eStatus::Repeated;
         }
+        let allowed = self
+            .config
+            .max_delta_counter
+            .saturating_add(self.widen)
+            .min(self.profile.counter_modulus() - 1);
         self.last_counter = Some(counter);
-        self.no_new_data = 0;
-        if delta <= allowed {
-            self.lost_frames += u64::from(delta - 1);
-            E2eStatus::Ok
-        } else {
-            E2eStatus::WrongSequence
+        self.widen = 0;
+        if delta > allowed {
+            self.no_new_or_repeated = 0;
+            self.sync_left = self.config.sync_counter;
+            return E2eStatus::WrongSequence;
         }
+        self.lost_frames += u64::from(delta - 1);
+        if self.no_new_or_repeated > self.config.max_no_new_or_repeated {
+            // Too many repeats or empty cycles: resynchronise, this frame being the first of
+            // the `sync_counter` in-sequence frames (Profile 1 reports it SYNC on top of them;
+            // counting it makes "N frames in sequence after a repeat" the same rule as after
+            // a jump).
+            self.sync_left = self.config.sync_counter;
+        }
+        self.no_new_or_repeated = 0;
+        if self.sync_left > 0 {
+            self.sync_left -= 1;
+            return E2eStatus::Sync;
+        }
+        E2eStatus::Ok
     }
 
     /// [`Self::check`] on a frame (a remote frame counts as an error).

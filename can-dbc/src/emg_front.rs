@@ -225,8 +225,9 @@ impl EmgFront {
         };
         let data = frame.data();
         match self.checkers[group].check(Some(data)) {
-            // A counter jump is the assembler's business: it bridges or reports a gap.
-            E2eStatus::Ok | E2eStatus::WrongSequence => {}
+            // A counter jump is the assembler's business: it bridges or reports a gap. (The
+            // checkers resynchronise at once, so `Sync` does not occur here.)
+            E2eStatus::Ok | E2eStatus::WrongSequence | E2eStatus::Sync => {}
             E2eStatus::Repeated => {
                 self.counters.repeated += 1;
                 return FrameVerdict::Repeated;

@@ -1,6 +1,8 @@
 //! E2E protection: CRC-8 SAE J1850 and every receiver status, counter wrap included.
 
-use hand_dbc::e2e::{crc8_j1850, E2eChecker, E2eError, E2eProfile, E2eProtector, E2eStatus};
+use hand_dbc::e2e::{
+    crc8_j1850, E2eCheckConfig, E2eChecker, E2eError, E2eProfile, E2eProtector, E2eStatus,
+};
 use hand_dbc::messages::{EmgSamplesG0, HandEstop, HandHeartbeat};
 
 #[test]
@@ -159,5 +161,225 @@ fn configuration_is_validated() {
     assert!(matches!(
         tx.protect_bytes(&mut [0; 3]),
         Err(E2eError::Length { .. })
+    ));
+}
+
+/// Every protected message of hand.dbc, its valid frames sent under every other protected
+/// message's id, is rejected by that message's receiver: no two share a CRC for any payload.
+/// (Before HAND_HEARTBEAT moved to data id 0x2300 it shared FINGER_STATUS_3's register and
+/// every FINGER_STATUS_3 frame passed as a heartbeat.)
+#[test]
+fn no_protected_frame_passes_under_another_protected_id() {
+    use hand_dbc::messages::MESSAGES;
+    let protected: Vec<_> = MESSAGES
+        .iter()
+        .filter_map(|m| m.e2e.map(|p| (m.name, p)))
+        .collect();
+    assert_eq!(protected.len(), 17);
+    let mut x: u32 = 0x9E37_79B9;
+    for &(name, profile) in &protected {
+        // Frames with every counter value and varied content: a CRC collision for one payload
+        // but not another is not possible (the register difference survives every byte), but
+        // the test does not rely on that argument.
+        let mut tx = E2eProtector::new(profile);
+        for _ in 0..2 * usize::from(profile.counter_modulus()) {
+            let mut data = vec![0u8; profile.dlc()];
+            for b in data.iter_mut().skip(1) {
+                x ^= x << 13;
+                x ^= x >> 17;
+                x ^= x << 5;
+                *b = x as u8;
+            }
+            tx.protect_bytes(&mut data).expect("own length");
+            let mut own = E2eChecker::try_new(profile, 1).expect("valid");
+            assert_eq!(own.check(Some(&data)), E2eStatus::Ok, "{name}");
+            for &(other_name, other) in &protected {
+                if other == profile {
+                    continue;
+                }
+                let mut rx = E2eChecker::try_new(other, 1).expect("valid");
+                assert_eq!(
+                    rx.check(Some(&data)),
+                    E2eStatus::Error,
+                    "a {name} frame passed as {other_name}"
+                );
+            }
+        }
+    }
+}
+
+/// One step of a Profile 1 scenario: the frame with sequence number `n` (counter `n % 16`),
+/// nothing (`None`), or a corrupted copy of frame `n`, and the status the check must give.
+#[derive(Clone, Copy)]
+enum Rx {
+    Frame(usize),
+    Nothing,
+    Corrupt(usize),
+}
+use E2eStatus::{Error, NoNewData, Repeated, Sync, WrongSequence};
+use Rx::{Corrupt, Frame, Nothing};
+
+/// Runs `steps` through a checker with `config` on a 4-bit, 8-byte profile and asserts every
+/// status.
+fn scenario(config: E2eCheckConfig, steps: &[(Rx, E2eStatus)]) {
+    let profile = E2eProfile::try_new(0x1100, 4, 8).expect("valid");
+    let frames = stream(profile, 64);
+    let mut rx = E2eChecker::with_config(profile, config).expect("valid");
+    for (i, &(step, want)) in steps.iter().enumerate() {
+        let got = match step {
+            Frame(n) => rx.check(Some(&frames[n])),
+            Nothing => rx.check(None),
+            Corrupt(n) => {
+                let mut bad = frames[n].clone();
+                bad[4] ^= 0x10;
+                rx.check(Some(&bad))
+            }
+        };
+        assert_eq!(got, want, "step {i}");
+    }
+}
+
+const OK: E2eStatus = E2eStatus::Ok;
+
+#[test]
+fn profile1_after_a_jump_the_sync_counter_holds_the_data_back() {
+    let p1 = E2eCheckConfig::profile1(1);
+    assert_eq!(p1.sync_counter, E2eCheckConfig::DEFAULT_SYNC_COUNTER);
+    assert_eq!(p1.sync_counter, 2);
+    scenario(
+        p1,
+        &[
+            (Frame(0), OK),
+            (Frame(1), OK),
+            (Frame(5), WrongSequence),
+            (Frame(6), Sync),
+            (Frame(7), Sync),
+            (Frame(8), OK),
+        ],
+    );
+    // Without the sync phase the frame right after the jump is used: the old behaviour.
+    scenario(
+        E2eCheckConfig::resync_at_once(1),
+        &[(Frame(0), OK), (Frame(5), WrongSequence), (Frame(6), OK)],
+    );
+}
+
+#[test]
+fn profile1_a_stray_frame_does_not_let_the_next_one_through() {
+    // A stray frame (right CRC, counter 9) lands in the real stream 0, 1, 2, 3, ...
+    scenario(
+        E2eCheckConfig::profile1(1),
+        &[
+            (Frame(0), OK),
+            (Frame(1), OK),
+            (Frame(9), WrongSequence),
+            (Frame(2), WrongSequence),
+            (Frame(3), Sync),
+            (Frame(4), Sync),
+            (Frame(5), OK),
+        ],
+    );
+}
+
+#[test]
+fn profile1_a_second_sender_interleaving_one_ahead_never_gets_data_used() {
+    // The real sender's frame n, then a second sender's guess of n + 1 before the real n + 1
+    // arrives (which then repeats it), and so on.
+    let mut steps = vec![(Frame(3), OK), (Frame(4), OK)];
+    for n in 5..12 {
+        // n is the intruder's, the real sender's n follows as a repeat.
+        steps.push((Frame(n), if n == 5 { OK } else { Sync }));
+        steps.push((Frame(n), Repeated));
+    }
+    scenario(E2eCheckConfig::profile1(1), &steps);
+    // Resynchronising at once, every intruder frame after the first repeat is used.
+    let mut steps = vec![(Frame(3), OK), (Frame(4), OK)];
+    for n in 5..12 {
+        steps.push((Frame(n), OK));
+        steps.push((Frame(n), Repeated));
+    }
+    scenario(E2eCheckConfig::resync_at_once(1), &steps);
+}
+
+#[test]
+fn profile1_a_repeat_needs_the_same_resynchronisation() {
+    scenario(
+        E2eCheckConfig::profile1(1),
+        &[
+            (Frame(0), OK),
+            (Frame(1), OK),
+            (Frame(1), Repeated),
+            (Frame(2), Sync),
+            (Frame(3), Sync),
+            (Frame(4), OK),
+        ],
+    );
+    // A repeat limit of 1 tolerates one repeat (or one empty cycle), not two.
+    let one = E2eCheckConfig {
+        max_no_new_or_repeated: 1,
+        ..E2eCheckConfig::profile1(1)
+    };
+    scenario(
+        one,
+        &[
+            (Frame(0), OK),
+            (Frame(0), Repeated),
+            (Frame(1), OK),
+            (Nothing, NoNewData),
+            (Frame(3), OK),
+            (Frame(3), Repeated),
+            (Nothing, NoNewData),
+            (Frame(5), Sync),
+            (Frame(6), Sync),
+            (Frame(7), OK),
+        ],
+    );
+}
+
+#[test]
+fn profile1_errors_widen_the_step_and_a_new_jump_restarts_the_sync() {
+    scenario(
+        E2eCheckConfig::profile1(1),
+        &[
+            (Frame(0), OK),
+            (Frame(5), WrongSequence),
+            // A corrupted frame neither ends nor restarts the sync; the sender counted it, so
+            // a step of 2 is in sequence after it.
+            (Corrupt(6), Error),
+            (Frame(7), Sync),
+            // Another jump during the sync starts it again.
+            (Frame(12), WrongSequence),
+            (Frame(13), Sync),
+            (Frame(14), Sync),
+            // Across the counter wrap (15 -> 0).
+            (Frame(15), OK),
+            (Frame(16), OK),
+        ],
+    );
+}
+
+#[test]
+fn profile1_the_sync_counter_is_a_setting() {
+    let n = |sync_counter| E2eCheckConfig {
+        sync_counter,
+        ..E2eCheckConfig::profile1(1)
+    };
+    scenario(
+        n(0),
+        &[(Frame(0), OK), (Frame(4), WrongSequence), (Frame(5), OK)],
+    );
+    let mut steps = vec![(Frame(0), OK), (Frame(4), WrongSequence)];
+    steps.extend((5..10).map(|k| (Frame(k), Sync)));
+    steps.push((Frame(10), OK));
+    scenario(n(5), &steps);
+    // The max delta is validated with the config.
+    let p = E2eProfile::try_new(1, 4, 8).expect("valid");
+    assert!(matches!(
+        E2eChecker::with_config(p, E2eCheckConfig::profile1(16)),
+        Err(E2eError::MaxDelta { value: 16, max: 15 })
+    ));
+    assert!(matches!(
+        E2eChecker::with_config(p, E2eCheckConfig::profile1(0)),
+        Err(E2eError::MaxDelta { value: 0, .. })
     ));
 }

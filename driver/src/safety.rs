@@ -3,7 +3,8 @@
 //! Transient faults (EMG silence, sporadic E2E errors, an invalid window, non-finite values in
 //! the chain, a saturated or lead-off channel) leave SAFE by themselves once no transient fault has been raised for the recovery
 //! time (500 ms by default). Latched faults (E-stop, bus-off or interface down, repeated E2E
-//! failure, model error, a technician's stop) stay until an explicit `arm`. Sporadic E2E errors
+//! failure, model error, a technician's stop, a second master on the bus) stay until an
+//! explicit `arm`. Sporadic E2E errors
 //! become a latched fault when `e2e_latch_count` of them fall within `e2e_latch_window_us`.
 //!
 //! Every change of state is returned as a [`Transition`] with its cause, for the caller to log.
@@ -83,6 +84,11 @@ pub enum Fault {
     /// A model was swapped in (a deploy or a rollback): the hand waits in SAFE, every finger
     /// from rest, until `arm` hands it to the new model.
     ModelSwapped,
+    /// Another node drives the fingers: handd received a FINGER_SETPOINT frame (SocketCAN does
+    /// not loop a socket's own frames back to it, so any it reads was sent by someone else), or
+    /// a finger controller reported ignoring a setpoint of a stale epoch long after handd's
+    /// current epoch was opened. Latched: a second master is not a transient.
+    SecondMaster,
     /// The bus works but not well enough to trust: the CAN controller is error-passive (its
     /// frames may go unacknowledged), or the transmit queue stayed full for longer than the
     /// finger controllers' own setpoint timeout. Transient: it clears when the controller is
@@ -92,7 +98,7 @@ pub enum Fault {
 
 impl Fault {
     /// All faults, in bit order.
-    pub const ALL: [Fault; 15] = [
+    pub const ALL: [Fault; 16] = [
         Fault::EmgSilence,
         Fault::E2eError,
         Fault::InvalidWindow,
@@ -107,6 +113,7 @@ impl Fault {
         Fault::Calibrating,
         Fault::NoModel,
         Fault::ModelSwapped,
+        Fault::SecondMaster,
         Fault::BusDegraded,
     ];
 
@@ -123,6 +130,7 @@ impl Fault {
                 | Fault::Calibrating
                 | Fault::NoModel
                 | Fault::ModelSwapped
+                | Fault::SecondMaster
         )
     }
 
@@ -148,6 +156,7 @@ impl Fault {
             Fault::Calibrating => "calibrating",
             Fault::NoModel => "no_model",
             Fault::ModelSwapped => "model_swapped",
+            Fault::SecondMaster => "second_master",
             Fault::BusDegraded => "bus_degraded",
         }
     }

@@ -6,7 +6,7 @@ mod common;
 
 use common::Rig;
 use driver::engine::Command;
-use driver::safety::DaemonState;
+use driver::safety::{DaemonState, Fault};
 use hand_dbc::messages::{FingerMode, FingerSetpoint};
 use hand_model::dbc::seal;
 use hand_model::faults::FaultPlan;
@@ -132,6 +132,15 @@ fn a_stale_setpoint_after_a_long_bus_off_does_not_move_the_finger_and_arm_resume
     r.bus.set_bus_off(false);
     r.run_until(ONSET + 700_000);
     stale_is_ignored_and_current_moves(&mut r, old);
+    // The probe that injected those frames is a second master: handd, which reads every
+    // FINGER_SETPOINT on the bus, latched it (issue 32). Arm once handd has read the last one
+    // (it reads a tick's frames at the tick).
+    r.run_until(r.clock_now() + TICK);
+    assert!(
+        r.runner.engine().faults().contains(Fault::SecondMaster),
+        "{}",
+        r.runner.engine().faults()
+    );
     // Armed, handd runs again in its epoch and every finger follows it.
     let now = r.clock_now();
     r.runner.engine_mut().command(now, Command::Arm).unwrap();

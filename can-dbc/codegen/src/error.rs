@@ -47,6 +47,21 @@ pub enum DbcError {
          or 8 bits at bit 8"
     )]
     E2eLayout { message: String },
+    /// Two protected messages of one length whose CRC registers after the data id are equal:
+    /// a frame of one is E2E-valid under the other's id.
+    #[error(
+        "{message} (data id {data_id:#06x}) and {other} (data id {other_data_id:#06x}): both \
+         {dlc} bytes with CRC register {register:#04x} after the data id, so a frame of one is \
+         E2E-valid as the other; choose another data id (bump the layout version nibble)"
+    )]
+    E2eCollision {
+        message: String,
+        data_id: u16,
+        other: String,
+        other_data_id: u16,
+        dlc: u32,
+        register: u8,
+    },
     /// A multiplexed or multiplexor signal.
     #[error("{message}.{signal}: multiplexing is not supported by the generator")]
     Multiplexed { message: String, signal: String },

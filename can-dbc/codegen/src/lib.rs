@@ -6,8 +6,9 @@
 //!
 //! 1. [`Bus::from_dbc`] ([`model`]) parses the DBC and validates it once, up front. Every
 //!    inconsistency (a range the bits cannot hold, overlapping signals, a value-table entry
-//!    outside its range, an E2E message without the fixed CRC/counter layout, Motorola byte
-//!    order, multiplexing, ...) is a [`DbcError`] naming the message and the signal.
+//!    outside its range, an E2E message without the fixed CRC/counter layout, two protected
+//!    messages of one length whose data ids leave the CRC register in the same state, Motorola
+//!    byte order, multiplexing, ...) is a [`DbcError`] naming the message and the signal.
 //! 2. [`render`] turns the model into Rust: one renderer per kind of output (enums, struct and
 //!    consts, constructor, accessors, encode/decode, frames, by-name access, the `Message`
 //!    dispatcher, the `MESSAGES` table). It cannot fail.

@@ -86,6 +86,32 @@ pub struct E2e {
     pub counter_bits: u32,
 }
 
+impl E2e {
+    /// The CRC-8 SAE J1850 register (poly 0x1D, init 0xFF, not yet finalised) after the data
+    /// id's two bytes, low byte first. The CRC of a payload depends on the data id only through
+    /// this register, so two messages of one length with equal registers carry the same CRC
+    /// for every payload: [`Bus::from_dbc`] refuses such a pair.
+    pub fn register(self) -> u8 {
+        crc_register_after_id(self.data_id)
+    }
+}
+
+/// The J1850 register after `data_id` (low byte first) from init 0xFF, bit by bit: the
+/// reference the generated code's table-driven `crc_after_id` must agree with.
+pub fn crc_register_after_id(data_id: u16) -> u8 {
+    data_id.to_le_bytes().iter().fold(0xFF, |mut crc: u8, &b| {
+        crc ^= b;
+        for _ in 0..8 {
+            crc = if crc & 0x80 != 0 {
+                (crc << 1) ^ 0x1D
+            } else {
+                crc << 1
+            };
+        }
+        crc
+    })
+}
+
 /// What a signal is at the Rust API.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Kind {

@@ -223,3 +223,71 @@ fn a_message_without_a_cycle_time_is_refused() {
         }
     );
 }
+
+/// A protected message `name` at CAN id `id`, `dlc` bytes, with a counter of `bits` bits.
+fn protected(name: &str, id: u32, dlc: u32, bits: u32) -> String {
+    format!(
+        "BO_ {id} {name}: {dlc} A\n SG_ Crc : 0|8@1+ (1,0) [0|255] \"u\" B\n \
+         SG_ Counter : 8|{bits}@1+ (1,0) [0|{}] \"u\" B\n",
+        (1u32 << bits) - 1
+    )
+}
+
+#[test]
+fn protected_messages_whose_crc_registers_collide_are_refused() {
+    use hand_dbc_codegen::model::crc_register_after_id;
+    // The pair hand.dbc had: FINGER_STATUS_3 (0x1283) and HAND_HEARTBEAT at version 1 (0x1300).
+    assert_eq!(crc_register_after_id(0x1283), 0xAB);
+    assert_eq!(crc_register_after_id(0x1300), 0xAB);
+    let ids = "BA_ \"HandE2EDataId\" BO_ 16 4739;\nBA_ \"HandE2EDataId\" BO_ 17 4864;";
+    let body = format!("{}\n{}", protected("S", 16, 8, 4), protected("H", 17, 8, 4));
+    let err = refused(&body, ids);
+    assert_eq!(
+        err,
+        DbcError::E2eCollision {
+            message: "S".into(),
+            data_id: 0x1283,
+            other: "H".into(),
+            other_data_id: 0x1300,
+            dlc: 8,
+            register: 0xAB,
+        }
+    );
+    assert!(err.to_string().starts_with(
+        "S (data id 0x1283) and H (data id 0x1300): both 8 bytes with CRC register 0xab"
+    ));
+    // The counter width does not save the pair: a 4-bit and an 8-bit counter collide too.
+    let mixed = format!("{}\n{}", protected("S", 16, 8, 4), protected("H", 17, 8, 8));
+    assert!(matches!(
+        refused(&mixed, ids),
+        DbcError::E2eCollision { register: 0xAB, .. }
+    ));
+    // Different lengths never collide: the receiver checks the length first.
+    let lengths = format!("{}\n{}", protected("S", 16, 8, 4), protected("H", 17, 7, 4));
+    assert!(Bus::from_dbc(&dbc(&lengths, ids)).is_ok());
+    // The next layout version of H (0x2300) has another register: accepted.
+    let bumped = "BA_ \"HandE2EDataId\" BO_ 16 4739;\nBA_ \"HandE2EDataId\" BO_ 17 8960;";
+    assert!(Bus::from_dbc(&dbc(&body, bumped)).is_ok());
+}
+
+/// The register table of hand.dbc: every protected message, its length and register, no two
+/// of one length alike. `cargo test -p hand-dbc-codegen --test refusals e2e_register_table --
+/// --nocapture` prints it.
+#[test]
+fn e2e_register_table() {
+    let bus = Bus::from_dbc(include_str!("../../hand.dbc")).expect("hand.dbc is valid");
+    let mut seen = std::collections::BTreeMap::new();
+    println!("message              dlc  data id  register");
+    for m in bus.groups.iter().flat_map(|g| &g.messages) {
+        let Some(e2e) = m.e2e else { continue };
+        let register = e2e.register();
+        println!(
+            "{:<20} {:>3}  {:#06x}   {register:#04x}",
+            m.name, m.dlc, e2e.data_id
+        );
+        if let Some(other) = seen.insert((m.dlc, register), m.name.clone()) {
+            panic!("{} and {other} share register {register:#04x}", m.name);
+        }
+    }
+    assert_eq!(seen.len(), 17, "hand.dbc protects 17 messages");
+}

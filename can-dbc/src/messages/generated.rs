@@ -3949,7 +3949,7 @@ impl crate::e2e::Protected for FingerStatus {
 ///
 /// handd heartbeat, 10 Hz.
 ///
-/// DLC 8, every 100 ms, sent by HAND, received by AMP, MC_0, MC_1, MC_2, MC_3, MC_4, TOOL. E2E protected: CRC-8 in byte 0, 4-bit alive counter (data id 0x1300)
+/// DLC 8, every 100 ms, sent by HAND, received by AMP, MC_0, MC_1, MC_2, MC_3, MC_4, TOOL. E2E protected: CRC-8 in byte 0, 4-bit alive counter (data id 0x2300)
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct HandHeartbeat {
     crc: u8,
@@ -3969,7 +3969,7 @@ impl HandHeartbeat {
     /// Send period from `GenMsgCycleTime` (ms).
     pub const CYCLE_TIME_MS: u32 = 100;
     /// E2E profile.
-    pub const E2E: E2eProfile = E2eProfile::from_dbc(0x1300, 4, 8);
+    pub const E2E: E2eProfile = E2eProfile::from_dbc(0x2300, 4, 8);
     /// Smallest allowed `Crc` (crc).
     pub const CRC_MIN: u8 = 0;
     /// Largest allowed `Crc` (crc).
@@ -4058,7 +4058,7 @@ impl HandHeartbeat {
         self.state = value;
     }
 
-    /// `FaultMask` (bitmask): handd's active faults, one bit each, as handctl status names them: bit 0 emg_silence, bit 1 e2e_error, bit 2 invalid_window, bit 3 non_finite, bit 4 signal_quality, bit 5 estop, bit 6 bus_off, bit 7 interface_down, bit 8 repeated_e2e, bit 9 model_error, bit 10 stop_requested, bit 11 calibrating, bit 12 no_model, bit 13 model_swapped, bit 14 bus_degraded; bit 15 unused. A finger whose controller fell silent is not a daemon fault: FINGER_STATUS and handctl status show it.
+    /// `FaultMask` (bitmask): handd's active faults, one bit each, as handctl status names them: bit 0 emg_silence, bit 1 e2e_error, bit 2 invalid_window, bit 3 non_finite, bit 4 signal_quality, bit 5 estop, bit 6 bus_off, bit 7 interface_down, bit 8 repeated_e2e, bit 9 model_error, bit 10 stop_requested, bit 11 calibrating, bit 12 no_model, bit 13 model_swapped, bit 14 second_master, bit 15 bus_degraded; all 16 bits in use. A finger whose controller fell silent is not a daemon fault: FINGER_STATUS and handctl status show it.
     pub fn fault_mask(&self) -> u16 {
         self.fault_mask
     }
@@ -4069,7 +4069,7 @@ impl HandHeartbeat {
         Ok(())
     }
 
-    /// `ModelId` (id): First 4 bytes (little-endian) of the loaded model file's checksum; 0 when no model is loaded.
+    /// `ModelId` (id): Fingerprint of the loaded model file: the 32-bit FNV-1a hash (offset basis 0x811C9DC5, prime 0x01000193) of the whole file's bytes, as handctl status shows it in hex; 0 when no model is loaded.
     pub fn model_id(&self) -> u32 {
         self.model_id
     }
@@ -5947,14 +5947,14 @@ pub const MESSAGES: &[MessageInfo] = &[
         cycle_time_ms: 100,
         senders: &["HAND"],
         receivers: &["AMP", "MC_0", "MC_1", "MC_2", "MC_3", "MC_4", "TOOL"],
-        e2e: Some(E2eProfile::from_dbc(0x1300, 4, 8)),
+        e2e: Some(E2eProfile::from_dbc(0x2300, 4, 8)),
         comment: "handd heartbeat, 10 Hz.",
         signals: &[
             SignalInfo { name: "Crc", start_bit: 0, size: 8, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 255.0, raw_min: 0, raw_max: 255, unit: "crc", values: &[], comment: "" },
             SignalInfo { name: "Counter", start_bit: 8, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 15.0, raw_min: 0, raw_max: 15, unit: "count", values: &[], comment: "" },
             SignalInfo { name: "State", start_bit: 12, size: 4, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 3.0, raw_min: 0, raw_max: 3, unit: "enum", values: &[(0, "BOOT"), (1, "READY"), (2, "RUNNING"), (3, "SAFE")], comment: "" },
-            SignalInfo { name: "FaultMask", start_bit: 16, size: 16, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 65535.0, raw_min: 0, raw_max: 65535, unit: "bitmask", values: &[], comment: "handd's active faults, one bit each, as handctl status names them: bit 0 emg_silence, bit 1 e2e_error, bit 2 invalid_window, bit 3 non_finite, bit 4 signal_quality, bit 5 estop, bit 6 bus_off, bit 7 interface_down, bit 8 repeated_e2e, bit 9 model_error, bit 10 stop_requested, bit 11 calibrating, bit 12 no_model, bit 13 model_swapped, bit 14 bus_degraded; bit 15 unused. A finger whose controller fell silent is not a daemon fault: FINGER_STATUS and handctl status show it." },
-            SignalInfo { name: "ModelId", start_bit: 32, size: 32, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 4294967295.0, raw_min: 0, raw_max: 4294967295, unit: "id", values: &[], comment: "First 4 bytes (little-endian) of the loaded model file's checksum; 0 when no model is loaded." },
+            SignalInfo { name: "FaultMask", start_bit: 16, size: 16, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 65535.0, raw_min: 0, raw_max: 65535, unit: "bitmask", values: &[], comment: "handd's active faults, one bit each, as handctl status names them: bit 0 emg_silence, bit 1 e2e_error, bit 2 invalid_window, bit 3 non_finite, bit 4 signal_quality, bit 5 estop, bit 6 bus_off, bit 7 interface_down, bit 8 repeated_e2e, bit 9 model_error, bit 10 stop_requested, bit 11 calibrating, bit 12 no_model, bit 13 model_swapped, bit 14 second_master, bit 15 bus_degraded; all 16 bits in use. A finger whose controller fell silent is not a daemon fault: FINGER_STATUS and handctl status show it." },
+            SignalInfo { name: "ModelId", start_bit: 32, size: 32, signed: false, factor: 1.0, offset: 0.0, min: 0.0, max: 4294967295.0, raw_min: 0, raw_max: 4294967295, unit: "id", values: &[], comment: "Fingerprint of the loaded model file: the 32-bit FNV-1a hash (offset basis 0x811C9DC5, prime 0x01000193) of the whole file's bytes, as handctl status shows it in hex; 0 when no model is loaded." },
         ],
     },
     MessageInfo {

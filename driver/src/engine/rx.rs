@@ -1,13 +1,34 @@
 //! The receive side: every frame in with its receive time. EMG sample frames go through the
 //! shared front end ([`EmgFront`]) into the signal chain; finger status feeds the watchdog,
 //! the amplifier's status the signal quality, an E-stop latches SAFE.
+//!
+//! Finger status is checked as AUTOSAR E2E Profile 1 means it
+//! ([`E2eCheckConfig::profile1`]): after a counter jump or a repeat, two in-sequence frames
+//! pass before a status is used again (not heard by the watchdog, its force, position and
+//! flags not read). HAND_ESTOP keeps resynchronising at once (its senders interleave counters,
+//! and a stop must never wait); EMG_STATUS too (a lead-off report must not wait either).
+//!
+//! Two masters on the bus are a latched fault, [`Fault::SecondMaster`]:
+//! - any FINGER_SETPOINT handd receives: SocketCAN does not loop a socket's own frames back to
+//!   it (handd does not set `recv_own_msgs`, and installs no receive filter, so every id
+//!   reaches the engine), so the frame came from another sender;
+//! - a controller's FINGER_STATUS fault bit 6 (it ignored a valid setpoint of another epoch)
+//!   more than [`STALE_EPOCH_GRACE_US`] after handd first heard that finger in its current
+//!   epoch: handd's own frames of an older epoch drain from the queues within milliseconds of
+//!   the new epoch's SAFE_STOP, so a later one is somebody else's.
+//!
+//! A controller's bit 4 (a setpoint failed its E2E check since its previous status) is what
+//! a second sender interleaving with handd, or a damaged bus, produces: one report is noted
+//! (a bus recovery legitimately gives one per finger: handd's counter jumped), and
+//! [`SETPOINT_E2E_LATCH`] reports from one finger within [`SETPOINT_E2E_WINDOW_US`] latch
+//! [`Fault::RepeatedE2e`].
 
 use decoder::dsp::{Chain, ChainSettings};
-use hand_dbc::e2e::{E2eChecker, E2eProfile, E2eStatus};
+use hand_dbc::e2e::{E2eCheckConfig, E2eChecker, E2eProfile, E2eStatus};
 use hand_dbc::emg_front::{EmgFront, EmgFrontConfig, EmgFrontSettings, FrameVerdict};
 use hand_dbc::messages::{
-    self, AmpSampleRate, AmpState, EmgStatus, EstopRequest, FingerState, FingerStatus, HandEstop,
-    Message,
+    self, AmpSampleRate, AmpState, EmgStatus, EstopRequest, FingerSetpoint, FingerState,
+    FingerStatus, HandEstop, Message,
 };
 use hand_dbc::CanFrame;
 
@@ -18,8 +39,25 @@ use crate::units::N_FINGERS;
 
 /// FINGER_STATUS fault bit 3 (hand.dbc): the controller braked by itself, setpoint timeout.
 const STATUS_SETPOINT_TIMEOUT: u8 = 1 << 3;
+/// FINGER_STATUS fault bit 4 (hand.dbc): a setpoint failed the controller's E2E check since
+/// its previous status.
+const STATUS_SETPOINT_E2E: u8 = 1 << 4;
 /// FINGER_STATUS fault bit 5 (hand.dbc): the joint is at a stop and the command pushes into it.
 const STATUS_JOINT_LIMIT: u8 = 1 << 5;
+/// FINGER_STATUS fault bit 6 (hand.dbc): the controller ignored a valid setpoint of a stale or
+/// not yet opened epoch since its previous status.
+const STATUS_STALE_EPOCH: u8 = 1 << 6;
+
+/// How long after handd first heard a finger in its current epoch a stale-epoch report (bit 6)
+/// may still be handd's own older frames, µs. Those leave the kernel's and the controller's
+/// queues before the new epoch's SAFE_STOP (FIFO per id), within a few ms at 1 Mbit/s; 200 ms
+/// also covers the tick that sends the SAFE_STOP and the status period (20 ms).
+pub const STALE_EPOCH_GRACE_US: u64 = 200_000;
+/// Status reports of bit 4 from one finger within [`SETPOINT_E2E_WINDOW_US`] that latch
+/// [`Fault::RepeatedE2e`].
+pub const SETPOINT_E2E_LATCH: usize = 3;
+/// See [`SETPOINT_E2E_LATCH`], µs.
+pub const SETPOINT_E2E_WINDOW_US: u64 = 1_000_000;
 
 /// The EMG stream: the front end, the signal chain it feeds and what the tick needs to know
 /// about the newest samples.
@@ -136,6 +174,11 @@ pub(super) struct Inputs {
     pub(super) last_amp_status_us: u64,
     /// What the amplifier's last status says is wrong with its samples, if anything.
     pub(super) amp_problem: Option<AmpProblem>,
+    /// Per finger: the epoch count ([`super::epoch::Epochs::begun`]) handd last heard the
+    /// finger in, and when it first heard it in that epoch.
+    epoch_heard: [(u64, u64); N_FINGERS],
+    /// Per finger: when its last `SETPOINT_E2E_LATCH - 1` bit-4 reports arrived, oldest first.
+    setpoint_e2e_at: [[Option<u64>; SETPOINT_E2E_LATCH - 1]; N_FINGERS],
 }
 
 /// EMG_STATUS at 10 Hz: three missed in a row (300 ms) is a silence, and the lead-off and
@@ -205,16 +248,16 @@ pub fn amp_problem(st: &EmgStatus, chain_hz: u32) -> Option<AmpProblem> {
     }
 }
 
-fn checker(profile: E2eProfile, max_delta: u16) -> E2eChecker {
-    E2eChecker::try_new(profile, max_delta).expect("hand.dbc's profiles accept these deltas")
+fn checker(profile: E2eProfile, config: E2eCheckConfig) -> E2eChecker {
+    E2eChecker::with_config(profile, config).expect("hand.dbc's profiles accept these deltas")
 }
 
 impl Inputs {
     pub(super) fn new(now_us: u64) -> Self {
         Self {
-            status: FingerStatus::E2E.map(|p| checker(p, 3)),
-            estop: checker(HandEstop::E2E, 15),
-            amp_status: checker(EmgStatus::E2E, 3),
+            status: FingerStatus::E2E.map(|p| checker(p, E2eCheckConfig::profile1(3))),
+            estop: checker(HandEstop::E2E, E2eCheckConfig::resync_at_once(15)),
+            amp_status: checker(EmgStatus::E2E, E2eCheckConfig::resync_at_once(3)),
             amp_reports_bad: false,
             reported_force: [0.0; N_FINGERS],
             reported_position: [0.0; N_FINGERS],
@@ -222,7 +265,31 @@ impl Inputs {
             amp_masks: (0, 0),
             last_amp_status_us: now_us,
             amp_problem: None,
+            epoch_heard: [(0, 0); N_FINGERS],
+            setpoint_e2e_at: [[None; SETPOINT_E2E_LATCH - 1]; N_FINGERS],
         }
+    }
+
+    /// Finger `f` was heard at `rx_us` in handd's epoch number `begun`: how long handd has
+    /// heard it in that epoch.
+    fn heard_in_epoch(&mut self, f: usize, begun: u64, rx_us: u64) -> u64 {
+        if self.epoch_heard[f].0 != begun {
+            self.epoch_heard[f] = (begun, rx_us);
+        }
+        rx_us.saturating_sub(self.epoch_heard[f].1)
+    }
+
+    /// Finger `f` reported a setpoint E2E error at `rx_us`: whether that makes
+    /// [`SETPOINT_E2E_LATCH`] within [`SETPOINT_E2E_WINDOW_US`].
+    fn setpoint_e2e_report(&mut self, f: usize, rx_us: u64) -> bool {
+        let times = &mut self.setpoint_e2e_at[f];
+        let repeated = times[0].is_some_and(|t| rx_us.saturating_sub(t) <= SETPOINT_E2E_WINDOW_US);
+        times.rotate_left(1);
+        times[SETPOINT_E2E_LATCH - 2] = Some(rx_us);
+        if repeated {
+            *times = [None; SETPOINT_E2E_LATCH - 1];
+        }
+        repeated
     }
 }
 
@@ -246,6 +313,12 @@ impl Engine {
             }
         }
         let id = frame.raw_id();
+        if FingerSetpoint::IDS.contains(&id) {
+            // Never our own (no loopback): another node is driving the fingers.
+            let t = self.safety.raise(rx_us, Fault::SecondMaster);
+            self.note(t);
+            return;
+        }
         match messages::decode(id, frame.data()) {
             Ok(msg) => self.on_message(&msg, frame.data(), rx_us),
             // A known id with a bad payload may be a corrupted safety frame: count it as an
@@ -275,8 +348,10 @@ impl Engine {
                         self.inputs.feedback[f] = Feedback {
                             at_joint_limit: s.faults() & STATUS_JOINT_LIMIT != 0,
                         };
+                        self.on_setpoint_reports(f, s.faults(), rx_us);
                     }
-                    E2eStatus::Repeated => {}
+                    // In sequence, but resynchronising after a jump or a repeat: not used.
+                    E2eStatus::Sync => {}
                     _ => self.counters.e2e_errors += 1,
                 }
             }
@@ -307,9 +382,136 @@ impl Engine {
         }
     }
 
+    /// What finger `f`'s controller says about the setpoints it received (status bits 4 and
+    /// 6): see the module docs.
+    fn on_setpoint_reports(&mut self, f: usize, faults: u8, rx_us: u64) {
+        let in_epoch_us = self.inputs.heard_in_epoch(f, self.epochs.begun(f), rx_us);
+        if faults & STATUS_STALE_EPOCH != 0 && in_epoch_us > STALE_EPOCH_GRACE_US {
+            let t = self.safety.raise(rx_us, Fault::SecondMaster);
+            self.note(t);
+        }
+        if faults & STATUS_SETPOINT_E2E != 0 && self.inputs.setpoint_e2e_report(f, rx_us) {
+            let t = self.safety.raise(rx_us, Fault::RepeatedE2e);
+            self.note(t);
+        }
+    }
+
     fn e2e_error(&mut self, at_us: u64) {
         self.counters.e2e_errors += 1;
         let t = self.safety.raise(at_us, Fault::E2eError);
         self.note(t);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use decoder::dsp::ChainConfig;
+    use hand_dbc::e2e::E2eProtector;
+
+    use super::*;
+    use crate::engine::EngineSettings;
+
+    fn engine() -> Engine {
+        let chain = ChainConfig::default().validate().expect("chain");
+        let mut e = Engine::without_model(&chain, EngineSettings::default(), 0);
+        e.validated(0);
+        e
+    }
+
+    /// FINGER_STATUS of finger `f`, ACTIVE, reporting `force` and `faults`, next counter of
+    /// `tx`.
+    fn status(tx: &mut E2eProtector, f: usize, force: f64, faults: u8) -> CanFrame {
+        let s = FingerStatus::new(f, FingerState::Active, 0.1, 0.0, force, faults).expect("range");
+        tx.protect_message(&s).expect("own profile")
+    }
+
+    #[test]
+    fn a_status_after_a_counter_jump_is_used_only_after_two_in_sequence() {
+        let mut e = engine();
+        let mut tx = E2eProtector::new(FingerStatus::E2E[2]);
+        e.on_frame(&status(&mut tx, 2, 1.0, 0), 20_000);
+        assert_eq!(e.reported_force()[2], 1.0);
+        // Eight frames lost (more than the 3 allowed): a wrong sequence, then two Sync.
+        for _ in 0..8 {
+            status(&mut tx, 2, 0.0, 0);
+        }
+        for (k, force) in [2.0, 3.0, 4.0].into_iter().enumerate() {
+            e.on_frame(&status(&mut tx, 2, force, 0), 40_000 + 20_000 * k as u64);
+            assert_eq!(
+                e.reported_force()[2],
+                1.0,
+                "frame {k} after the jump was used"
+            );
+        }
+        e.on_frame(&status(&mut tx, 2, 5.0, 0), 100_000);
+        assert_eq!(e.reported_force()[2], 5.0);
+    }
+
+    #[test]
+    fn a_setpoint_frame_received_is_a_latched_second_master() {
+        let mut e = engine();
+        assert!(!e.faults().contains(Fault::SecondMaster));
+        let sp =
+            FingerSetpoint::new(0, messages::FingerMode::SafeStop, 0.0, 0.0, 7).expect("range");
+        let frame = E2eProtector::new(FingerSetpoint::E2E[0])
+            .protect_message(&sp)
+            .expect("own profile");
+        e.on_frame(&frame, 1_000);
+        assert!(e.faults().contains(Fault::SecondMaster));
+        assert!(Fault::SecondMaster.is_latched());
+        assert_eq!(Fault::SecondMaster.name(), "second_master");
+        assert_eq!(Fault::SecondMaster.bit(), 1 << 14);
+        // Whatever the frame holds: a wrong length or CRC does not make it handd's own.
+        let mut e = engine();
+        let short = CanFrame::new_standard(FingerSetpoint::IDS[4] as u16, &[0; 3]).expect("frame");
+        e.on_frame(&short, 2_000);
+        assert!(e.faults().contains(Fault::SecondMaster));
+    }
+
+    #[test]
+    fn a_stale_epoch_report_long_into_the_epoch_is_a_second_master() {
+        let mut e = engine();
+        let mut tx = E2eProtector::new(FingerStatus::E2E[1]);
+        // Heard first at 20 ms; a stale-epoch report within the grace is handd's own queue.
+        e.on_frame(&status(&mut tx, 1, 0.0, 0), 20_000);
+        e.on_frame(&status(&mut tx, 1, 0.0, STATUS_STALE_EPOCH), 40_000);
+        assert!(!e.faults().contains(Fault::SecondMaster));
+        let late = 20_000 + STALE_EPOCH_GRACE_US + 20_000;
+        e.on_frame(&status(&mut tx, 1, 0.0, 0), late - 20_000);
+        e.on_frame(&status(&mut tx, 1, 0.0, STATUS_STALE_EPOCH), late);
+        assert!(e.faults().contains(Fault::SecondMaster));
+        // A new epoch restarts the grace.
+        let mut e = engine();
+        let mut tx = E2eProtector::new(FingerStatus::E2E[1]);
+        e.on_frame(&status(&mut tx, 1, 0.0, 0), 20_000);
+        e.new_epoch();
+        e.on_frame(&status(&mut tx, 1, 0.0, 0), late - 20_000);
+        e.on_frame(&status(&mut tx, 1, 0.0, STATUS_STALE_EPOCH), late);
+        assert!(!e.faults().contains(Fault::SecondMaster));
+    }
+
+    #[test]
+    fn repeated_setpoint_e2e_reports_of_one_finger_latch_repeated_e2e() {
+        let mut e = engine();
+        let mut tx: [E2eProtector; N_FINGERS] = FingerStatus::E2E.map(E2eProtector::new);
+        // One report from every finger (a bus recovery): nothing latched.
+        for (f, tx) in tx.iter_mut().enumerate() {
+            e.on_frame(&status(tx, f, 0.0, STATUS_SETPOINT_E2E), 20_000);
+        }
+        assert!(!e.faults().contains(Fault::RepeatedE2e), "{}", e.faults());
+        // A second and a third report from finger 3 within a second: latched.
+        e.on_frame(&status(&mut tx[3], 3, 0.0, STATUS_SETPOINT_E2E), 400_000);
+        assert!(!e.faults().contains(Fault::RepeatedE2e));
+        e.on_frame(&status(&mut tx[3], 3, 0.0, 0), 420_000);
+        e.on_frame(&status(&mut tx[3], 3, 0.0, STATUS_SETPOINT_E2E), 440_000);
+        assert!(e.faults().contains(Fault::RepeatedE2e), "{}", e.faults());
+        // Reports spread wider than the window do not latch.
+        let mut e = engine();
+        let mut tx = E2eProtector::new(FingerStatus::E2E[0]);
+        for k in 0..6u64 {
+            let t = 20_000 + k * (SETPOINT_E2E_WINDOW_US / 2 + 20_000);
+            e.on_frame(&status(&mut tx, 0, 0.0, STATUS_SETPOINT_E2E), t);
+        }
+        assert!(!e.faults().contains(Fault::RepeatedE2e), "{}", e.faults());
     }
 }

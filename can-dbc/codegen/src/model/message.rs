@@ -18,6 +18,7 @@ impl Bus {
         for m in &dbc.messages {
             messages.push(message(&dbc, m, &mut reader, &mut seen_ids)?);
         }
+        e2e_registers_differ(&messages)?;
         let enums = reader.into_enums();
         Ok(Bus {
             enums: enums_of(enums),
@@ -158,4 +159,34 @@ fn is_counter(k: &Signal) -> bool {
         && k.kind == Kind::Int
         && k.raw_min == 0
         && k.raw_max == (1 << k.size) - 1
+}
+
+/// No two protected messages of one length share the CRC register after the data id.
+///
+/// The CRC covers the data id and then payload bytes 1..DLC, so the data id matters only
+/// through that register: equal registers and equal lengths mean one CRC for every payload,
+/// and a frame of one message is E2E-valid under the other's id. The counter width is left
+/// out of the rule on purpose: it only says which bits of byte 1 the receiver reads as the
+/// counter, the CRC still matches, and any byte-1 value is some counter value, so a 4-bit and
+/// an 8-bit message collide just the same. Different lengths never collide (the receiver
+/// checks the length before the CRC). Different registers never do either: the register
+/// difference passes through the CRC table, a bijection, for every payload byte, so the two
+/// CRCs differ for every payload.
+fn e2e_registers_differ(messages: &[Message]) -> Result<(), DbcError> {
+    let mut seen: BTreeMap<(u32, u8), &Message> = BTreeMap::new();
+    for m in messages {
+        let Some(e2e) = m.e2e else { continue };
+        let register = e2e.register();
+        if let Some(first) = seen.insert((m.dlc, register), m) {
+            return Err(DbcError::E2eCollision {
+                message: first.name.clone(),
+                data_id: first.e2e.map_or(0, |e| e.data_id),
+                other: m.name.clone(),
+                other_data_id: e2e.data_id,
+                dlc: m.dlc,
+                register,
+            });
+        }
+    }
+    Ok(())
 }
