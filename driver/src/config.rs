@@ -243,6 +243,8 @@ pub struct Config {
     pub fingers: Fingers,
     /// The control socket.
     pub control: ControlConfig,
+    /// Where handd keeps what must survive a restart (its latches: see `driver::persist`).
+    pub state_dir: PathBuf,
 }
 
 impl Default for Config {
@@ -256,6 +258,7 @@ impl Default for Config {
             timeouts: Timeouts::default(),
             fingers: Fingers::default(),
             control: ControlConfig::default(),
+            state_dir: PathBuf::from("/var/lib/handstack"),
         }
     }
 }
@@ -379,6 +382,13 @@ impl Config {
                 allowed: "a filesystem path for the Unix socket".into(),
             });
         }
+        if !self.state_dir.is_absolute() {
+            return Err(ConfigError::Invalid {
+                field: "state_dir".into(),
+                value: format!("{:?}", self.state_dir),
+                allowed: "an absolute directory path handd may write (its systemd StateDirectory, /var/lib/handstack)".into(),
+            });
+        }
         Ok(())
     }
 
@@ -486,6 +496,8 @@ mod tests {
         );
         let c = Config::from_toml("deadline_slack_ms = 20\n", Path::new("h.toml")).unwrap();
         assert_eq!(c.deadline_slack_ms, 20);
+        let e = Config::from_toml("state_dir = \"state\"\n", Path::new("h.toml")).unwrap_err();
+        assert!(e.to_string().contains("state_dir = \"state\""), "{e}");
     }
 
     #[test]

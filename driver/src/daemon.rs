@@ -4,6 +4,14 @@
 //! the bus's health handled (stop sending, drop queued frames, reopen with backoff and send
 //! safe stops at once, stay SAFE), and a status snapshot published for `handctl status`.
 //!
+//! The latches a restart must keep are published after every tick to the writer thread
+//! ([`crate::persist`]: a store into an atomic word and a `try_send`, no file I/O in the
+//! tick). A bus that is down when handd starts ([`Runner::with_bus_down`]) is waited for: SAFE
+//! (EMG silence: nothing is heard), reopened with the same backoff, and once it carries
+//! frames the hand recovers by the ordinary rule, with no `arm` (the hand never moved in this
+//! process, so nothing is undone). [`Runner::shutdown`] sends the last round of safe stops on
+//! SIGTERM and saves the latches.
+//!
 //! [`Runner::step`] does one tick at a given time, so tests drive it on a virtual clock;
 //! [`Runner::run_realtime`] sleeps to each absolute deadline on the system clock.
 
@@ -140,6 +148,9 @@ pub struct Runner<T: Transport, K: Clock> {
     frames_tx: u64,
     bus_load: BusLoad,
     publish_skips: u64,
+    latches: Option<crate::persist::LatchPublisher>,
+    /// The bus has not been open yet in this process (started with it down).
+    never_opened: bool,
 }
 
 impl<T: Transport, K: Clock> Runner<T, K> {
@@ -163,7 +174,60 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             frames_tx: 0,
             bus_load: BusLoad::new(tick_us),
             publish_skips: 0,
+            latches: None,
+            never_opened: false,
         }
+    }
+
+    /// The loop for a bus that could not be opened at start: SAFE at once (the engine hears
+    /// no EMG), a reopen attempt at once and then with backoff. Nothing latches: once the bus
+    /// carries frames the hand recovers after the usual recovery time.
+    pub fn with_bus_down(mut self) -> Self {
+        let now = self.clock.now_us();
+        self.bus_ok = false;
+        self.never_opened = true;
+        self.next_reopen_us = now;
+        self.engine.raise(now, Fault::EmgSilence);
+        self
+    }
+
+    /// The latches are published to `publisher` after every tick (see [`crate::persist`]).
+    pub fn with_latches(mut self, publisher: crate::persist::LatchPublisher) -> Self {
+        self.latches = Some(publisher);
+        self
+    }
+
+    /// Whether the bus is usable now.
+    pub fn bus_ok(&self) -> bool {
+        self.bus_ok
+    }
+
+    /// The last round before exit (SIGTERM): safe stops for every finger in its current epoch,
+    /// whatever the state, then the latches published and waited for on disk (up to
+    /// `save_wait`). Returns the safe stops sent and whether the latches are saved (true when
+    /// there is no latch file).
+    pub fn shutdown(&mut self, save_wait: std::time::Duration) -> (usize, bool) {
+        let mut sent = 0;
+        if self.bus_ok {
+            for f in self.engine.shutdown_frames() {
+                match self.transport.send(f) {
+                    Ok(()) => sent += 1,
+                    Err(e) => {
+                        tracing::warn!(error = %e, "shutdown: safe stops not all sent");
+                        break;
+                    }
+                }
+            }
+            self.frames_tx += sent as u64;
+        }
+        let saved = match &mut self.latches {
+            Some(p) => {
+                p.publish(self.engine.latches());
+                p.flush(save_wait)
+            }
+            None => true,
+        };
+        (sent, saved)
     }
 
     /// Commands from the control thread.
@@ -231,6 +295,14 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             return false;
         }
         match self.transport.reopen() {
+            Ok(()) if self.never_opened => {
+                self.never_opened = false;
+                tracing::warn!(
+                    "bus up: the hand leaves SAFE once the signal is good for the recovery time"
+                );
+                self.bus_ok = true;
+                true
+            }
             Ok(()) => {
                 // Frames of the old epoch may still be queued where we cannot purge them.
                 self.engine.new_epoch();
@@ -353,6 +425,9 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             },
         );
         self.publish(deadline);
+        if let Some(p) = &mut self.latches {
+            p.publish(self.engine.latches());
+        }
         self.next_deadline_us += self.tick_us;
         // After a long stall, skip the missed ticks rather than run them back to back.
         if self.next_deadline_us + self.tick_us < t1 {

@@ -47,17 +47,34 @@ impl ControlHandler {
         swap: Command,
         rx: &std::sync::mpsc::Receiver<Box<ModelSwap>>,
     ) -> Result<Box<ModelSwap>, DeployError> {
+        let ticket = match &swap {
+            Command::Swap(b) => b.ticket.clone(),
+            _ => unreachable!("swap_in is given a swap"),
+        };
         self.send(swap)
             .map_err(|_| DeployError::Loop("the control loop is not running".into()))?;
-        match rx.recv_timeout(SWAP_WAIT) {
-            Ok(b) if b.swapped => Ok(b),
-            Ok(_) => Err(DeployError::Loop(
+        let reply = match rx.recv_timeout(self.swap_wait) {
+            // Too late: cancel, so the swap still queued is never applied behind the reply.
+            Err(_) if ticket.cancel() => {
+                return Err(DeployError::Loop(format!(
+                    "the control loop did not take the model within {:.1} s; the swap is cancelled",
+                    self.swap_wait.as_secs_f64()
+                )))
+            }
+            // The loop took it just now: the swap happened, and its reply is on the way.
+            Err(_) => rx.recv_timeout(self.swap_wait).map_err(|_| {
+                DeployError::Loop(
+                    "the control loop took the model but did not answer; see handd's log".into(),
+                )
+            })?,
+            Ok(b) => b,
+        };
+        if reply.swapped {
+            Ok(reply)
+        } else {
+            Err(DeployError::Loop(
                 "the loop refused the model: its inputs do not fit the chain".into(),
-            )),
-            Err(_) => Err(DeployError::Loop(format!(
-                "the control loop did not take the model within {} s",
-                SWAP_WAIT.as_secs()
-            ))),
+            ))
         }
     }
 
@@ -87,11 +104,12 @@ impl ControlHandler {
         };
         self.config = next;
         let replaced = self.model.replace(status.clone());
+        let previous = replaced.as_ref().map_or("none".into(), |s| s.id.clone());
         self.previous = match (old.predictor.is_some(), replaced) {
             (true, Some(s)) => Some((old, s)),
             _ => None,
         };
-        self.after_swap("deploy", &status, path, peer, user, force)
+        self.after_swap("deploy", &status, &previous, path, peer, user, force)
     }
 
     /// `rollback`: the model the last deploy or rollback replaced comes back (so a second
@@ -114,6 +132,7 @@ impl ControlHandler {
         let (tx, rx) = sync_channel(1);
         back.back = Some(tx);
         back.swapped = false;
+        back.ticket = crate::engine::SwapTicket::new();
         let old = match self.swap_in(Command::Swap(back), &rx) {
             Ok(old) => old,
             Err(e) => {
@@ -124,9 +143,10 @@ impl ControlHandler {
         };
         self.config = next;
         let replaced = self.model.replace(status.clone());
+        let previous = replaced.as_ref().map_or("none".into(), |s| s.id.clone());
         self.previous = replaced.map(|s| (old, s));
         let path = status.path.clone();
-        self.after_swap("rollback", &status, &path, peer, user, false)
+        self.after_swap("rollback", &status, &previous, &path, peer, user, false)
     }
 
     /// The live lines name the model now running, with its file's rest levels (read here, on
@@ -154,11 +174,14 @@ impl ControlHandler {
         }
     }
 
-    /// Audit, log, release the calibrating hold's first condition, and the reply.
+    /// Audit, log, release the calibrating hold's first condition, and the reply; `previous` is
+    /// the id of the model replaced ("none" when there was none).
+    #[allow(clippy::too_many_arguments, reason = "one audit line's fields")]
     fn after_swap(
         &mut self,
         action: &str,
         status: &ModelStatus,
+        previous: &str,
         source: &str,
         peer: Peer,
         user: &str,
@@ -170,7 +193,7 @@ impl ControlHandler {
             self.hold = Hold::Deployed;
         }
         let what = format!(
-            "{action} path={source} installed={} id={} force={force}",
+            "{action} path={source} installed={} id={} previous={previous} force={force}",
             status.path, status.id
         );
         audit(&self.config.control.audit_log, user, peer, &what);
