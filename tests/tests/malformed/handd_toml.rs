@@ -13,6 +13,7 @@ model = "/var/lib/handstack/model.hsm"
 tick_ms = 50
 deadline_slack_ms = 5
 mains_hz = 50
+state_dir = "/var/lib/handstack"
 
 [timeouts]
 emg_silence_ms = 100
@@ -49,6 +50,7 @@ fn is_field(field: &str) -> bool {
         "timeouts.finger_silence_ms",
         "timeouts.recovery_ms",
         "control.socket",
+        "state_dir",
     ];
     const FINGER: &[&str] = &[
         "kf",
