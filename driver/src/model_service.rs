@@ -253,10 +253,12 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("handd-ms-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).expect("scratch directory");
-        let mut config = Config::default();
-        config.model = dir.join("model.hsm");
+        let mut config = Config {
+            model: dir.join("model.hsm"),
+            state_dir: dir.clone(),
+            ..Config::default()
+        };
         config.control.audit_log = dir.join("audit.log");
-        config.state_dir = dir.clone();
         let path = dir.join("handd.toml");
         config.save_atomic(&path).expect("config saved");
         (dir, config, path)
@@ -266,7 +268,6 @@ mod tests {
         match r {
             Reply::Ok { message, .. } => message.clone(),
             Reply::Refused { reason } => format!("refused: {reason}"),
-            other => format!("{other:?}"),
         }
     }
 
