@@ -410,6 +410,8 @@ pub fn spawn_writer(
     let thread_path = path.clone();
     std::thread::Builder::new()
         .name("handd-latches".into())
+        // Small, like the control threads: locked memory makes a stack resident in full.
+        .stack_size(crate::control::THREAD_STACK_BYTES)
         .spawn(move || writer(&thread_path, &thread_shared, &rx))?;
     Ok((
         LatchPublisher {

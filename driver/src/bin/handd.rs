@@ -227,15 +227,17 @@ fn run(args: &Args) -> Result<(), String> {
     });
     let _ = sd_notify::notify(&[sd_notify::NotifyState::Stopping]);
     let (sent, saved) = runner.shutdown(Duration::from_secs(1));
+    let stops = if sent > 0 {
+        "safe stops sent to every finger"
+    } else {
+        "no safe stops sent (the bus is down)"
+    };
     if saved {
-        tracing::info!(
-            safe_stops = sent,
-            "stopping: safe stops sent, latches saved"
-        );
+        tracing::info!(safe_stops = sent, "stopping: {stops}; latches saved");
     } else {
         tracing::error!(
             safe_stops = sent,
-            "stopping: the latches could NOT be saved (see above)"
+            "stopping: {stops}; the latches could NOT be saved (see above)"
         );
     }
     Ok(())
