@@ -393,34 +393,65 @@ impl LatchStore {
     }
 }
 
-/// Starts the writer thread for the file at `path`, which holds `on_disk` now (None when it
-/// is missing or unusable: the first published set is then written). Returns the loop's and
-/// the control side's ends; the thread ends when the publisher is dropped, after a last write.
-pub fn spawn_writer(
+/// The writer's end, before it runs: [`LatchWriter::spawn`] starts its thread.
+pub struct LatchWriter {
+    path: PathBuf,
+    shared: Arc<Shared>,
+    wake: Receiver<()>,
+}
+
+impl LatchWriter {
+    /// Starts the writer thread (`handd-latches`); it ends when the publisher is dropped,
+    /// after a last write.
+    pub fn spawn(self) -> std::io::Result<()> {
+        std::thread::Builder::new()
+            .name("handd-latches".into())
+            // Small, like the control threads: locked memory makes a stack resident in full.
+            .stack_size(crate::control::THREAD_STACK_BYTES)
+            .spawn(move || writer(&self.path, &self.shared, &self.wake))?;
+        Ok(())
+    }
+}
+
+/// The three ends for the file at `path`, which holds `on_disk` now (None when it is missing
+/// or unusable: the first published set is then written): the loop's, the control side's and
+/// the writer's (not started).
+pub fn latch_channel(
     path: PathBuf,
     on_disk: Option<Latches>,
-) -> std::io::Result<(LatchPublisher, LatchStore)> {
+) -> (LatchPublisher, LatchStore, LatchWriter) {
     let shared = Arc::new(Shared {
         pending: AtomicU32::new(0),
         written: Mutex::new(on_disk.map(Latches::code)),
         saved: Condvar::new(),
     });
     let (wake, rx) = sync_channel(1);
-    let thread_shared = Arc::clone(&shared);
-    let thread_path = path.clone();
-    std::thread::Builder::new()
-        .name("handd-latches".into())
-        // Small, like the control threads: locked memory makes a stack resident in full.
-        .stack_size(crate::control::THREAD_STACK_BYTES)
-        .spawn(move || writer(&thread_path, &thread_shared, &rx))?;
-    Ok((
+    (
         LatchPublisher {
             shared: Arc::clone(&shared),
             wake,
             last: 0,
         },
-        LatchStore { shared, path },
-    ))
+        LatchStore {
+            shared: Arc::clone(&shared),
+            path: path.clone(),
+        },
+        LatchWriter {
+            path,
+            shared,
+            wake: rx,
+        },
+    )
+}
+
+/// [`latch_channel`] with its writer thread started: the loop's and the control side's ends.
+pub fn spawn_writer(
+    path: PathBuf,
+    on_disk: Option<Latches>,
+) -> std::io::Result<(LatchPublisher, LatchStore)> {
+    let (publisher, store, writer) = latch_channel(path, on_disk);
+    writer.spawn()?;
+    Ok((publisher, store))
 }
 
 fn writer(path: &Path, shared: &Shared, wake: &Receiver<()>) {
