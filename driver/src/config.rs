@@ -267,6 +267,8 @@ pub struct Config {
     pub control: ControlConfig,
     /// What `deploy` demands of a model's verification.
     pub deploy: DeployConfig,
+    /// Where handd keeps what must survive a restart (its latches: see `driver::persist`).
+    pub state_dir: PathBuf,
 }
 
 impl Default for Config {
@@ -281,6 +283,7 @@ impl Default for Config {
             fingers: Fingers::default(),
             control: ControlConfig::default(),
             deploy: DeployConfig::default(),
+            state_dir: PathBuf::from("/var/lib/handstack"),
         }
     }
 }
@@ -416,6 +419,13 @@ impl Config {
                 allowed: "a filesystem path for the Unix socket".into(),
             });
         }
+        if !self.state_dir.is_absolute() {
+            return Err(ConfigError::Invalid {
+                field: "state_dir".into(),
+                value: format!("{:?}", self.state_dir),
+                allowed: "an absolute directory path handd may write (its systemd StateDirectory, /var/lib/handstack)".into(),
+            });
+        }
         Ok(())
     }
 
@@ -523,6 +533,8 @@ mod tests {
         );
         let c = Config::from_toml("deadline_slack_ms = 20\n", Path::new("h.toml")).unwrap();
         assert_eq!(c.deadline_slack_ms, 20);
+        let e = Config::from_toml("state_dir = \"state\"\n", Path::new("h.toml")).unwrap_err();
+        assert!(e.to_string().contains("state_dir = \"state\""), "{e}");
     }
 
     #[test]

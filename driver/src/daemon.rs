@@ -4,6 +4,14 @@
 //! the bus's health handled (stop sending, drop queued frames, reopen with backoff and send
 //! safe stops at once, stay SAFE), and a status snapshot published for `handctl status`.
 //!
+//! The latches a restart must keep are published after every tick to the writer thread
+//! ([`crate::persist`]: a store into an atomic word and a `try_send`, no file I/O in the
+//! tick). A bus that is down when handd starts ([`Runner::with_bus_down`]) is waited for: SAFE
+//! (EMG silence: nothing is heard), reopened with the same backoff, and once it carries
+//! frames the hand recovers by the ordinary rule, with no `arm` (the hand never moved in this
+//! process, so nothing is undone). [`Runner::shutdown`] sends the last round of safe stops on
+//! SIGTERM and saves the latches.
+//!
 //! [`Runner::step`] does one tick at a given time, so tests drive it on a virtual clock;
 //! [`Runner::run_realtime`] sleeps to each absolute deadline on the system clock.
 
@@ -119,14 +127,18 @@ pub type SharedSnapshot = Arc<Mutex<Snapshot>>;
 /// control side's queue is bounded too, so a flood of commands cannot lengthen a tick).
 pub const MAX_COMMANDS_PER_TICK: usize = 8;
 
-/// First and longest wait between attempts to reopen a failed bus, µs. Short at first, because
-/// the first frames after a reopen are the safe stops the finger controllers need within
-/// 100 ms. It doubles after every failure, a reopen that is followed by a failure before the
-/// bus carried a frame included (a controller still bus-off, or no one to ACK): such a loop
-/// would otherwise spin, logging and starting a new setpoint epoch every 10 ms. It resets once
-/// the bus has taken a frame of ours again (the safe stops sent at the reopen do not count:
+/// First and longest wait between attempts to reopen a failed bus, µs. Short, because the
+/// first frames after a reopen are the safe stops the finger controllers need within 100 ms;
+/// capped at one 50 ms tick, because a failed attempt costs only a check of the interface.
+pub const REOPEN_BACKOFF_US: (u64, u64) = (10_000, 50_000);
+
+/// Longest wait before reopening a bus that failed again after a reopen before it took a
+/// frame of ours (a controller still bus-off, or no one to ACK), µs. Such a loop would
+/// otherwise spin, logging and starting a new setpoint epoch every 10 ms; this wait doubles
+/// from [`REOPEN_BACKOFF_US`]'s first one at every such failure, up to this, and resets once
+/// the bus has taken a tick's frames again (the safe stops sent at the reopen do not count:
 /// the first of them is what fails on a controller that is still bus-off).
-pub const REOPEN_BACKOFF_US: (u64, u64) = (10_000, 1_000_000);
+pub const SPIN_BACKOFF_MAX_US: u64 = 1_000_000;
 
 /// A transmit queue that stays full this long raises [`Fault::BusDegraded`], µs: the finger
 /// controllers brake by themselves after 150 ms without a setpoint anyway.
@@ -182,10 +194,15 @@ pub struct Runner<T: Transport, K: Clock> {
     reopen_failures: u64,
     /// A tick's frames were all taken since the last reopen (the bus carries our frames).
     carried: bool,
+    /// The wait after a reopen that failed before it carried a frame (0: none such).
+    spin_us: u64,
     failure_log: LogLimit,
     reopen_log: LogLimit,
     /// The amplifier's status problem last logged.
     amp_problem: Option<AmpProblem>,
+    latches: Option<crate::persist::LatchPublisher>,
+    /// The bus has not been open yet in this process (started with it down).
+    never_opened: bool,
 }
 
 impl<T: Transport, K: Clock> Runner<T, K> {
@@ -213,10 +230,64 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             tx_queue_full: 0,
             reopen_failures: 0,
             carried: true,
+            spin_us: 0,
             failure_log: LogLimit::default(),
             reopen_log: LogLimit::default(),
             amp_problem: None,
+            latches: None,
+            never_opened: false,
         }
+    }
+
+    /// The loop for a bus that could not be opened at start: SAFE at once (the engine hears
+    /// no EMG), a reopen attempt at once and then with backoff. Nothing latches: once the bus
+    /// carries frames the hand recovers after the usual recovery time.
+    pub fn with_bus_down(mut self) -> Self {
+        let now = self.clock.now_us();
+        self.bus_ok = false;
+        self.never_opened = true;
+        self.next_reopen_us = now;
+        self.engine.raise(now, Fault::EmgSilence);
+        self
+    }
+
+    /// The latches are published to `publisher` after every tick (see [`crate::persist`]).
+    pub fn with_latches(mut self, publisher: crate::persist::LatchPublisher) -> Self {
+        self.latches = Some(publisher);
+        self
+    }
+
+    /// Whether the bus is usable now.
+    pub fn bus_ok(&self) -> bool {
+        self.bus_ok
+    }
+
+    /// The last round before exit (SIGTERM): safe stops for every finger in its current epoch,
+    /// whatever the state, then the latches published and waited for on disk (up to
+    /// `save_wait`). Returns the safe stops sent and whether the latches are saved (true when
+    /// there is no latch file).
+    pub fn shutdown(&mut self, save_wait: std::time::Duration) -> (usize, bool) {
+        let mut sent = 0;
+        if self.bus_ok {
+            for f in self.engine.shutdown_frames() {
+                match self.transport.send(f) {
+                    Ok(()) => sent += 1,
+                    Err(e) => {
+                        tracing::warn!(error = %e, "shutdown: safe stops not all sent");
+                        break;
+                    }
+                }
+            }
+            self.frames_tx += sent as u64;
+        }
+        let saved = match &mut self.latches {
+            Some(p) => {
+                p.publish(self.engine.latches());
+                p.flush(save_wait)
+            }
+            None => true,
+        };
+        (sent, saved)
     }
 
     /// Commands from the control thread.
@@ -289,13 +360,14 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         if self.bus_ok {
             self.bus_ok = false;
             // A bus that failed again before it carried a frame since the last reopen: wait
-            // longer before the next attempt (see REOPEN_BACKOFF_US).
-            self.backoff_us = if self.carried {
-                REOPEN_BACKOFF_US.0
+            // longer before the next attempt (see SPIN_BACKOFF_MAX_US).
+            self.spin_us = if self.carried {
+                0
             } else {
-                (self.backoff_us * 2).min(REOPEN_BACKOFF_US.1)
+                (self.spin_us * 2).clamp(REOPEN_BACKOFF_US.0, SPIN_BACKOFF_MAX_US)
             };
-            self.next_reopen_us = now_us + self.backoff_us;
+            self.backoff_us = REOPEN_BACKOFF_US.0;
+            self.next_reopen_us = now_us + self.backoff_us.max(self.spin_us);
         }
     }
 
@@ -315,6 +387,14 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             return false;
         }
         match self.transport.reopen() {
+            Ok(()) if self.never_opened => {
+                self.never_opened = false;
+                tracing::warn!(
+                    "bus up: the hand leaves SAFE once the signal is good for the recovery time"
+                );
+                self.bus_ok = true;
+                true
+            }
             Ok(()) => {
                 // Frames of the old epoch may still be queued where we cannot purge them.
                 self.engine.new_epoch();
@@ -472,6 +552,9 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         );
         self.log_amp_problem();
         self.publish(deadline);
+        if let Some(p) = &mut self.latches {
+            p.publish(self.engine.latches());
+        }
         self.next_deadline_us += self.tick_us;
         // After a long stall, skip the missed ticks rather than run them back to back.
         if self.next_deadline_us + self.tick_us < t1 {

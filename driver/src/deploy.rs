@@ -191,15 +191,26 @@ pub fn point_config(
     Ok(next)
 }
 
-/// Appends one line to the audit log: time, who (user, uid, pid), what (`action` with its
-/// details). A failure is logged, never fatal.
-pub fn audit(log: &Path, user: &str, peer: Peer, action: &str) {
+/// The audit log's times: `time=` the wall clock (Unix seconds) and `mono=` the monotonic
+/// clock (seconds since boot, CLOCK_MONOTONIC), so the order and the spacing of the lines stay
+/// true when the wall clock is stepped (NTP's first sync on a board without RTC, `date -s`).
+pub fn audit_times() -> String {
     let time_s = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0.0, |d| d.as_secs_f64());
+    let m = rustix::time::clock_gettime(rustix::time::ClockId::Monotonic);
+    let mono_s = m.tv_sec as f64 + m.tv_nsec as f64 * 1e-9;
+    format!("time={time_s:.3} mono={mono_s:.3}")
+}
+
+/// Appends one line to the audit log: times ([`audit_times`]), who (user, uid, pid), what
+/// (`action` with its details). A failure is logged, never fatal.
+pub fn audit(log: &Path, user: &str, peer: Peer, action: &str) {
     let line = format!(
-        "time={time_s:.3} user={user} uid={} pid={} {action}",
-        peer.uid, peer.pid
+        "{} user={user} uid={} pid={} {action}",
+        audit_times(),
+        peer.uid,
+        peer.pid
     );
     let write = || -> std::io::Result<()> {
         if let Some(dir) = log.parent().filter(|d| !d.as_os_str().is_empty()) {

@@ -18,6 +18,7 @@ pub mod live;
 #[cfg(feature = "sim")]
 pub mod mem_transport;
 pub mod model_service;
+pub mod persist;
 pub mod protocol;
 pub mod rt;
 pub mod rx_times;

@@ -1,5 +1,6 @@
 //! The daemon's side of the technicians' protocol: answers `status`, applies `tune` (checked,
-//! persisted atomically, audited, then handed to the loop for the next tick), `arm` and `stop`.
+//! persisted atomically, audited, then handed to the loop for the next tick), `arm` and `stop`
+//! (both audited; `stop` answers once its latch is saved for a restart, or says it is not).
 //! Every request is checked completely before anything is applied. Commands reach the loop
 //! through a bounded queue ([`COMMAND_QUEUE`]); the tick takes at most
 //! [`crate::daemon::MAX_COMMANDS_PER_TICK`] per tick, so a flood of commands waits here (the
@@ -13,8 +14,11 @@ use decoder::dsp::ChainConfig;
 use crate::config::Config;
 use crate::control::Peer;
 use crate::daemon::SharedSnapshot;
+use crate::deploy::audit;
 use crate::engine::{Command, Hold, ModelSwap};
+use crate::persist::{LatchStore, STOP_SAVE_WAIT};
 use crate::protocol::{FingerStatus, ModelStatus, Reply, Request, Status};
+use crate::safety::Fault;
 use crate::tuning::{commit_tune, plan_tune, user_name};
 use crate::units::{FINGER_NAMES, N_FINGERS};
 
@@ -39,6 +43,10 @@ pub struct ControlHandler {
     pub(crate) no_model: bool,
     /// The live feed's model, replaced on every deploy and rollback.
     pub(crate) live_model: Option<crate::control::SharedLiveModel>,
+    /// The latch file's writer, when latches are kept (`stop` waits for its latch there).
+    latches: Option<LatchStore>,
+    /// How long a deploy or rollback waits for the loop to take the model.
+    pub(crate) swap_wait: std::time::Duration,
 }
 
 impl ControlHandler {
@@ -65,7 +73,24 @@ impl ControlHandler {
             hold: Hold::Free,
             no_model: false,
             live_model: None,
+            latches: None,
+            swap_wait: crate::model_service::SWAP_WAIT,
         }
+    }
+
+    /// The handler, for a loop whose latches are kept by `store` (`crate::persist`), starting
+    /// with the calibrating hold `hold` restored from it.
+    pub fn with_latches(mut self, store: LatchStore, hold: Hold) -> Self {
+        self.latches = Some(store);
+        self.hold = hold;
+        self
+    }
+
+    /// The handler, waiting `wait` (instead of [`crate::model_service::SWAP_WAIT`]) for the
+    /// loop to take a deployed model; a test's loop that never takes it fails faster.
+    pub fn with_swap_wait(mut self, wait: std::time::Duration) -> Self {
+        self.swap_wait = wait;
+        self
     }
 
     /// The handler, keeping the live feed's model (`LiveFeed::model`) up to date on deploy and
@@ -148,25 +173,48 @@ impl ControlHandler {
             Request::Calibrating => self.calibrating(peer, &user),
             Request::Deploy { path, force } => self.deploy(&path, force, peer, &user),
             Request::Rollback => self.rollback(peer, &user),
-            Request::Arm => self.arm(&user),
+            Request::Arm => self.arm(peer, &user),
             Request::Subscribe { .. } => Reply::Refused {
                 reason: "subscribe is served by the control socket, not by this handler".into(),
             },
-            Request::Stop => match self.send(Command::Stop) {
-                Ok(()) => {
-                    tracing::warn!(user, "stopped by a technician");
-                    Reply::Ok {
-                        message: "stopped: every finger safe-stopped until `handctl arm`".into(),
-                        status: None,
-                    }
+            Request::Stop => self.stop(peer, &user),
+        }
+    }
+
+    /// `stop`: handed to the loop, audited, and answered once the latch is on disk (so a
+    /// restart keeps it), or with a plain warning that it could not be confirmed there.
+    fn stop(&mut self, peer: Peer, user: &str) -> Reply {
+        if let Err(r) = self.send(Command::Stop) {
+            return *r;
+        }
+        audit(&self.config.control.audit_log, user, peer, "stop");
+        tracing::warn!(user, "stopped by a technician");
+        let saved = match &self.latches {
+            None => String::new(),
+            Some(store) => {
+                if store.wait_written(|l| l.faults.contains(Fault::StopRequested), STOP_SAVE_WAIT) {
+                    format!(
+                        "; saved in {}: a restart of handd keeps it",
+                        store.path().display()
+                    )
+                } else {
+                    tracing::error!(path = %store.path().display(), "stop: the latch was not saved within {} s", STOP_SAVE_WAIT.as_secs());
+                    format!(
+                        "; WARNING: the stop was NOT confirmed saved in {} within {} s (see                          handd's log): a restart of handd may not keep it",
+                        store.path().display(),
+                        STOP_SAVE_WAIT.as_secs()
+                    )
                 }
-                Err(r) => *r,
-            },
+            }
+        };
+        Reply::Ok {
+            message: format!("stopped: every finger safe-stopped until `handctl arm`{saved}"),
+            status: None,
         }
     }
 
     /// `arm`, refused while calibrating (until a deploy or rollback) and without a model.
-    fn arm(&mut self, user: &str) -> Reply {
+    fn arm(&mut self, peer: Peer, user: &str) -> Reply {
         let refused = match (self.hold, self.no_model) {
             (Hold::Calibrating, _) => Some(crate::safety::ArmError::Calibrating),
             (_, true) => Some(crate::safety::ArmError::NoModel),
@@ -180,6 +228,7 @@ impl ControlHandler {
         match self.send(Command::Arm) {
             Ok(()) => {
                 self.hold = Hold::Free;
+                audit(&self.config.control.audit_log, user, peer, "arm");
                 tracing::warn!(user, "armed by a technician");
                 Reply::Ok {
                     message:

@@ -154,15 +154,21 @@ pub fn interface_up(iface: &str) -> Result<(), TransportError> {
 impl<K: Clock> SocketCanTransport<K> {
     /// Opens `iface`; the error says what is missing.
     pub fn open(iface: &str, clock: K) -> Result<Self, TransportError> {
-        let mut t = Self {
+        let mut t = Self::closed(iface, clock);
+        t.reopen()?;
+        Ok(t)
+    }
+
+    /// `iface`, not open yet: every receive and send fails until a [`Transport::reopen`]
+    /// succeeds (handd starts this way when the bus is down, and reopens it with backoff).
+    pub fn closed(iface: &str, clock: K) -> Self {
+        Self {
             iface: iface.to_owned(),
             socket: None,
             clock,
             rx_times: RxTimes::default(),
             health: BusHealth::default(),
-        };
-        t.reopen()?;
-        Ok(t)
+        }
     }
 
     fn map_io(&self, e: std::io::Error) -> TransportError {

@@ -4,7 +4,6 @@
 use std::fs::OpenOptions;
 use std::io::Write;
 use std::path::Path;
-use std::time::{SystemTime, UNIX_EPOCH};
 
 use crate::config::{limits, Config, FingerConfig};
 use crate::units::{finger_index, FINGER_NAMES};
@@ -86,21 +85,19 @@ fn append_audit(path: &Path, change: &TuneChange, user: &str) -> std::io::Result
         std::fs::create_dir_all(dir)?;
     }
     let mut f = OpenOptions::new().create(true).append(true).open(path)?;
-    writeln!(f, "{}", audit_line(unix_time_s(), user, change))?;
+    writeln!(
+        f,
+        "{}",
+        audit_line(&crate::deploy::audit_times(), user, change)
+    )?;
     f.sync_data()
 }
 
-fn unix_time_s() -> f64 {
-    SystemTime::now()
-        .duration_since(UNIX_EPOCH)
-        .map(|d| d.as_secs_f64())
-        .unwrap_or(0.0)
-}
-
-/// One audit record: time, user, finger, old and new values (space-separated key=value).
-pub fn audit_line(time_s: f64, user: &str, c: &TuneChange) -> String {
+/// One audit record: times (`time=… mono=…`, [`crate::deploy::audit_times`]), user, finger,
+/// old and new values (space-separated key=value).
+pub fn audit_line(times: &str, user: &str, c: &TuneChange) -> String {
     format!(
-        "time={time_s:.3} user={user} finger={} kf={}->{} kalpha={}->{}",
+        "{times} user={user} finger={} kf={}->{} kalpha={}->{}",
         FINGER_NAMES[c.finger], c.old.kf, c.new.kf, c.old.kalpha, c.new.kalpha
     )
 }
@@ -163,6 +160,12 @@ mod tests {
             audit.contains("user=tech finger=middle kf=10->4.5 kalpha=3->3"),
             "{audit}"
         );
+        let mono: f64 = audit
+            .split(' ')
+            .find_map(|kv| kv.strip_prefix("mono="))
+            .and_then(|v| v.parse().ok())
+            .expect("a mono= field");
+        assert!(mono > 0.0 && audit.starts_with("time="), "{audit}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

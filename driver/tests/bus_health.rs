@@ -7,7 +7,7 @@ mod common;
 use std::sync::{Arc, Mutex};
 
 use common::{random_predictor, Rig};
-use driver::daemon::REOPEN_BACKOFF_US;
+use driver::daemon::SPIN_BACKOFF_MAX_US;
 use driver::engine::Command;
 use driver::mem_transport::MemTransport;
 use driver::safety::{DaemonState, Fault};
@@ -156,7 +156,7 @@ fn a_bus_that_reopens_but_cannot_send_backs_off_instead_of_spinning() {
     // The bus works again: the next reopen sticks, the backoff resets once frames arrive, and
     // arm brings the hand back.
     cue.lock().unwrap().sends_fail = false;
-    r.run_until(ONSET + 3_000_000 + REOPEN_BACKOFF_US.1 + 200_000);
+    r.run_until(ONSET + 3_000_000 + SPIN_BACKOFF_MAX_US + 200_000);
     let now = r.clock_now();
     r.runner.engine_mut().command(now, Command::Arm).unwrap();
     r.run_until(now + 1_000_000);

@@ -145,7 +145,12 @@ fn a_stale_setpoint_after_a_long_bus_off_does_not_move_the_finger_and_arm_resume
     let now = r.clock_now();
     r.runner.engine_mut().command(now, Command::Arm).unwrap();
     r.run_until(now + 1_000_000);
-    assert_eq!(r.runner.engine().state(), DaemonState::Running);
+    assert_eq!(
+        r.runner.engine().state(),
+        DaemonState::Running,
+        "{}",
+        r.runner.engine().faults()
+    );
     for f in r.world.fingers() {
         assert_eq!(f.state(), FingerState::Active, "finger {}", f.finger());
     }

@@ -1,5 +1,6 @@
 //! `handd`'s startup as a new user (or systemd) meets it: a bad config is reported once, and a
-//! log that does not go to a terminal carries no ANSI colour escapes.
+//! log that does not go to a terminal carries no ANSI colour escapes; a bus that is down at
+//! start keeps handd up, SAFE; SIGHUP is ignored and SIGTERM ends it cleanly.
 
 use std::path::PathBuf;
 use std::process::{Command, Output};
@@ -75,4 +76,81 @@ fn json_logs_carry_the_error_once_and_no_colour() {
         stderr.lines().all(|l| l.starts_with('{')),
         "every line is a JSON object:\n{stderr}"
     );
+}
+
+/// handd as a service meets it: a bus that is down at start (here an interface that does not
+/// exist) and no model. Returns the child and its scratch directory.
+fn start_without_bus(name: &str) -> (std::process::Child, PathBuf) {
+    let dir = std::env::temp_dir().join(format!("handd-startup-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch directory");
+    let group = Command::new("id").arg("-gn").output().expect("id -gn");
+    let group = String::from_utf8_lossy(&group.stdout).trim().to_owned();
+    let config = dir.join("handd.toml");
+    std::fs::write(
+        &config,
+        format!(
+            "interface = \"hsnocan{}\"\nmodel = \"{}\"\nstate_dir = \"{}\"\n\n[control]\n\
+             socket = \"{}\"\ngroup = \"{group}\"\naudit_log = \"{}\"\n",
+            std::process::id() % 10_000,
+            dir.join("model.hsm").display(),
+            dir.display(),
+            dir.join("handctl.sock").display(),
+            dir.join("audit.log").display(),
+        ),
+    )
+    .expect("config");
+    let child = Command::new(env!("CARGO_BIN_EXE_handd"))
+        .arg("--config")
+        .arg(&config)
+        .env_remove("NOTIFY_SOCKET")
+        .env_remove("RUST_LOG")
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("handd starts");
+    (child, dir)
+}
+
+fn signal(child: &std::process::Child, sig: rustix::process::Signal) {
+    let pid = rustix::process::Pid::from_raw(child.id() as i32).expect("a pid");
+    rustix::process::kill_process(pid, sig).expect("signal sent");
+}
+
+#[test]
+fn with_the_bus_down_handd_stays_up_ignores_sighup_and_stops_cleanly_on_sigterm() {
+    let (mut child, dir) = start_without_bus("busdown");
+    let latches = dir.join("latches");
+    let t0 = std::time::Instant::now();
+    while !latches.exists() && t0.elapsed() < std::time::Duration::from_secs(10) {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    assert!(latches.exists(), "the latch file is written");
+    signal(&child, rustix::process::Signal::HUP);
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    assert!(
+        child.try_wait().expect("wait").is_none(),
+        "handd stays up with the bus down and after SIGHUP"
+    );
+    signal(&child, rustix::process::Signal::TERM);
+    let out = child.wait_with_output().expect("handd exits");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "a clean exit on SIGTERM:\n{stderr}"
+    );
+    for want in [
+        "bus down at start",
+        "no latch file: nothing latched",
+        "SIGHUP ignored",
+        "stopping: no safe stops sent (the bus is down); latches saved",
+    ] {
+        assert!(stderr.contains(want), "{want:?} in the log:\n{stderr}");
+    }
+    let text = std::fs::read_to_string(&latches).expect("latches");
+    assert!(
+        text.contains("latched=\nhold=free"),
+        "nothing latched is kept: {text}"
+    );
+    std::fs::remove_dir_all(&dir).expect("clean up");
 }

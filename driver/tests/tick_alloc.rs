@@ -1,7 +1,8 @@
 //! Proof that the daemon's tick never touches the heap: a counting global allocator
 //! (`stats_alloc`, which holds the unsafe code) around 10 s of real traffic from the simulated
 //! amplifier and finger controllers going through `Engine::on_frame`, 200 ticks and their
-//! latency bookkeeping. Runs without the test harness so no other thread allocates while the
+//! latency bookkeeping, and the latch set published to the writer's channel every tick (its
+//! writer thread not started: it allocates, off the loop). Runs without the test harness so no other thread allocates while the
 //! region is measured.
 
 mod common;
@@ -48,6 +49,11 @@ fn main() {
         0,
     );
     engine.validated(0);
+    let (mut latches, _store, _writer) =
+        driver::persist::latch_channel(std::env::temp_dir().join("tick-alloc-latches"), None);
+    let mut stop = driver::safety::FaultSet::default();
+    stop.insert(driver::safety::Fault::StopRequested);
+    let stopped = driver::persist::Latches::of(stop, driver::engine::Hold::Free);
     let mut sent = 0usize;
     let mut next = 0usize;
     let mut deadline = 50_000u64;
@@ -59,6 +65,10 @@ fn main() {
         }
         sent += engine.tick(deadline, deadline).len();
         engine.written(deadline + 20, 20);
+        // A change every tick, as the loop publishes it (the first fills the wake-up slot,
+        // the rest find it full).
+        latches.publish(engine.latches());
+        latches.publish(stopped);
         deadline += 50_000;
     }
     let stats = region.change();

@@ -185,6 +185,11 @@ impl<F: Clone> MemBus<F> {
         lock(&self.inner).bus_off = on;
     }
 
+    /// Whether the bus is bus-off now (a controller without carrier).
+    pub fn is_bus_off(&self) -> bool {
+        lock(&self.inner).bus_off
+    }
+
     /// Endpoints currently attached.
     pub fn endpoints(&self) -> usize {
         lock(&self.inner).live_endpoints()

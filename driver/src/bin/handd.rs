@@ -1,11 +1,16 @@
 //! `handd`: the handstack daemon. Reads sEMG from the amplifier on the CAN bus, runs the signal
 //! chain and the model every 50 ms, and sends per-finger setpoints to the motor controllers.
 //! See README.md ("Installing handd on the board") and `handd --help`.
+//!
+//! As a service: latches (E-stop, a technician's stop, the calibrating hold, ...) are kept in
+//! `state_dir` and honoured at start (`driver::persist`); a bus that is down at start is
+//! waited for, SAFE; SIGTERM and SIGINT send one round of safe stops and save the latches
+//! before exit; SIGHUP is ignored (restart handd to load a changed config).
 
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{mpsc, Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -15,8 +20,9 @@ use decoder::model::Model as _;
 use driver::config::{Config, DEFAULT_CONFIG_PATH};
 use driver::control::{ControlServer, LiveFeed, LiveModel};
 use driver::daemon::Runner;
-use driver::engine::{Command, Engine};
+use driver::engine::{Command, Engine, Hold};
 use driver::live::ModelInfo;
+use driver::persist::LatchStore;
 use driver::rt::{lock_memory, set_fifo, RtReport};
 use driver::service::{ControlHandler, COMMAND_QUEUE};
 use driver::socketcan_bus::SocketCanTransport;
@@ -162,8 +168,11 @@ fn run(args: &Args) -> Result<(), String> {
         print_check(args, &config, loaded.as_ref());
         return Ok(());
     }
+    let latch_file = driver::persist::latch_path(&config.state_dir);
     // Saves killed midway (a writer's .tmp.PID files) are cleaned up before anything runs.
-    remove_stale_temps(&[&args.config, &config.model]);
+    remove_stale_temps(&[&args.config, &config.model, &latch_file]);
+    let restored = driver::persist::load(&latch_file);
+    restored.log(&latch_file);
 
     let mut rt = RtReport::default();
     lock_memory(&mut rt);
@@ -172,17 +181,44 @@ fn run(args: &Args) -> Result<(), String> {
     }
 
     let clock = SystemClock::new();
-    let transport =
-        SocketCanTransport::open(&config.interface, clock).map_err(|e| format!("bus: {e}"))?;
-    let (engine, chain) = build_engine(&config, loaded.as_ref(), clock.now_us());
+    let (transport, bus_down) = match SocketCanTransport::open(&config.interface, clock) {
+        Ok(t) => (t, false),
+        Err(e) => {
+            tracing::error!(error = %e, "bus down at start: the hand stays SAFE; reopening until it is up");
+            (SocketCanTransport::closed(&config.interface, clock), true)
+        }
+    };
+    let (mut engine, chain) = build_engine(&config, loaded.as_ref(), clock.now_us());
+    let latches = restored.latches();
+    engine.restore(clock.now_us(), latches);
+    let (publisher, store) = driver::persist::spawn_writer(latch_file, restored.on_disk())
+        .map_err(|e| format!("latch writer thread: {e}"))?;
     let (tx, rx) = mpsc::sync_channel(COMMAND_QUEUE);
-    let mut runner = Runner::new(engine, transport, clock, config.tick_ms * 1000).with_commands(rx);
-    spawn_control(args, &config, loaded.as_ref(), &runner, chain, tx)?;
+    let mut runner = Runner::new(engine, transport, clock, config.tick_ms * 1000)
+        .with_commands(rx)
+        .with_latches(publisher);
+    if bus_down {
+        runner = runner.with_bus_down();
+    }
+    spawn_control(
+        args,
+        &config,
+        loaded.as_ref(),
+        &runner,
+        chain,
+        tx,
+        (store, latches.hold),
+    )?;
 
     let stop = Arc::new(AtomicBool::new(false));
     for sig in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
         signal_hook::flag::register(sig, Arc::clone(&stop)).map_err(|e| format!("signals: {e}"))?;
     }
+    // SIGHUP is ignored (its default would end handd, and systemd would count that as a clean
+    // exit): a changed handd.toml takes effect with `systemctl restart handd`.
+    let hangup = Arc::new(AtomicBool::new(false));
+    signal_hook::flag::register(signal_hook::consts::SIGHUP, Arc::clone(&hangup))
+        .map_err(|e| format!("signals: {e}"))?;
     // Only now: threads inherit the policy, and the control threads (spawned above, and the
     // connections they spawn) must not compete with the loop at its priority.
     loop_priority(args.rt_priority);
@@ -198,9 +234,25 @@ fn run(args: &Args) -> Result<(), String> {
                 last_ping = Instant::now();
             }
         }
+        if hangup.swap(false, Ordering::Relaxed) {
+            tracing::warn!("SIGHUP ignored: to load a changed config, `systemctl restart handd`");
+        }
     });
     let _ = sd_notify::notify(&[sd_notify::NotifyState::Stopping]);
-    tracing::info!("stopping");
+    let (sent, saved) = runner.shutdown(Duration::from_secs(1));
+    let stops = if sent > 0 {
+        "safe stops sent to every finger"
+    } else {
+        "no safe stops sent (the bus is down)"
+    };
+    if saved {
+        tracing::info!(safe_stops = sent, "stopping: {stops}; latches saved");
+    } else {
+        tracing::error!(
+            safe_stops = sent,
+            "stopping: {stops}; the latches could NOT be saved (see above)"
+        );
+    }
     Ok(())
 }
 
@@ -228,6 +280,7 @@ fn spawn_control(
     runner: &Runner<SocketCanTransport<SystemClock>, SystemClock>,
     chain: ChainConfig,
     commands: mpsc::SyncSender<Command>,
+    (latches, hold): (LatchStore, Hold),
 ) -> Result<(), String> {
     let live_model = Arc::new(Mutex::new(LiveModel {
         info: ModelInfo {
@@ -252,7 +305,8 @@ fn spawn_control(
         commands,
     )
     .with_chain(chain)
-    .with_live_model(live_model);
+    .with_live_model(live_model)
+    .with_latches(latches, hold);
     let mut handler = match loaded {
         Some(l) => handler.with_model(l.status(&config.model)),
         None => handler.without_model(),

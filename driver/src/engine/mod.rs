@@ -24,7 +24,7 @@ mod tx;
 
 pub use epoch::{fresh_epoch, fresh_epochs};
 pub use rx::{amp_problem, AmpProblem, AMP_STATUS_SILENCE_US};
-pub use swap::{Hold, ModelSwap};
+pub use swap::{Hold, ModelSwap, SwapTicket};
 
 use decoder::dsp::ChainSettings;
 use decoder::model::Predictor;
@@ -246,6 +246,25 @@ impl Engine {
         self.note(t);
         if self.predictor.is_none() {
             self.raise(now_us, Fault::NoModel);
+        }
+    }
+
+    /// The latches a restart must keep (every latched fault but `no_model`, and the
+    /// calibrating hold): the loop publishes them every tick (`crate::persist`). No allocation.
+    pub fn latches(&self) -> crate::persist::Latches {
+        crate::persist::Latches::of(self.safety.latched(), self.hold)
+    }
+
+    /// Takes over the latches a previous process left (`crate::persist::load`), after
+    /// [`Engine::validated`]: SAFE with each of them latched, and the calibrating hold as it
+    /// was, so `arm` (after a deploy, for the hold) is needed as before the restart.
+    pub fn restore(&mut self, now_us: u64, latches: crate::persist::Latches) {
+        for f in latches.faults.iter() {
+            self.raise(now_us, f);
+        }
+        self.hold = latches.hold;
+        if latches.hold == Hold::Calibrating {
+            self.raise(now_us, Fault::Calibrating);
         }
     }
 

@@ -16,13 +16,19 @@
 //! `try_send`: no allocation, no waiting). The chain and its filter state stay, so the new
 //! model runs on the very next tick's window and no tick is skipped.
 //!
+//! A deploy whose reply timed out must not swap later behind the technician's back: every swap
+//! carries a [`SwapTicket`] that either the loop takes (and swaps) or the control side cancels
+//! (and the loop then sends the box back unswapped), never both.
+//!
 //! The calibrating hold ([`Command::Calibrating`]) latches [`Fault::Calibrating`]: the state is
 //! SAFE and every finger gets SAFE_STOP setpoints (zero force, zero velocity, brake), the same
 //! frames every other stop sends. `arm` is refused until a model has been swapped in after the
 //! hold began (a deploy, a rollback, or redeploying the running model after an aborted
 //! calibration); the `arm` that follows clears the hold.
 
+use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::mpsc::SyncSender;
+use std::sync::Arc;
 
 use decoder::model::Predictor;
 
@@ -38,8 +44,43 @@ pub struct ModelSwap {
     pub model_id: u32,
     /// Where the box goes back after the swap, holding the model replaced.
     pub back: Option<SyncSender<Box<ModelSwap>>>,
-    /// Set by the loop when it swapped (false: the predictor did not fit, nothing changed).
+    /// Set by the loop when it swapped (false: the predictor did not fit, or the swap was
+    /// cancelled; nothing changed).
     pub swapped: bool,
+    /// Taken by the loop or cancelled by the sender, whichever comes first.
+    pub ticket: SwapTicket,
+}
+
+/// Who decides a swap: the loop takes the ticket before it swaps, the sender cancels it when
+/// it gives up waiting; one compare-and-swap each, so exactly one of them wins.
+#[derive(Debug, Clone, Default)]
+pub struct SwapTicket(Arc<AtomicU8>);
+
+const PENDING: u8 = 0;
+const TAKEN: u8 = 1;
+const CANCELLED: u8 = 2;
+
+impl SwapTicket {
+    /// A new, pending ticket.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The loop's side: true if the swap may go ahead (and then it can no longer be
+    /// cancelled). No allocation.
+    pub fn take(&self) -> bool {
+        self.0
+            .compare_exchange(PENDING, TAKEN, Ordering::AcqRel, Ordering::Acquire)
+            .is_ok()
+    }
+
+    /// The sender's side: true if the swap is cancelled (the loop will not swap); false if the
+    /// loop has taken it already (the swap happened or is happening: its reply is coming).
+    pub fn cancel(&self) -> bool {
+        self.0
+            .compare_exchange(PENDING, CANCELLED, Ordering::AcqRel, Ordering::Acquire)
+            .is_ok()
+    }
 }
 
 /// Where the calibrating hold stands.
@@ -98,7 +139,9 @@ impl Engine {
         let fits = m
             .predictor
             .as_ref()
-            .is_some_and(|p| p.n_inputs() == self.emg.chain.settings().n_features());
+            .is_some_and(|p| p.n_inputs() == self.emg.chain.settings().n_features())
+            // Last: a ticket taken must be swapped (its sender then waits for the reply).
+            && m.ticket.take();
         m.swapped = fits;
         if fits {
             std::mem::swap(&mut self.predictor, &mut m.predictor);
@@ -132,6 +175,7 @@ impl Command {
             model_id,
             back: Some(back),
             swapped: false,
+            ticket: SwapTicket::new(),
         }))
     }
 }
@@ -192,6 +236,27 @@ mod tests {
         assert_eq!(e.labels, [0.0; crate::units::N_FINGERS]);
         e.command(40, Command::Arm).expect("arm");
         assert!(!e.faults().contains(Fault::ModelSwapped));
+    }
+
+    #[test]
+    fn a_cancelled_swap_comes_back_unswapped_and_a_taken_one_cannot_be_cancelled() {
+        let chain = ChainConfig::default().validate().expect("chain");
+        let mut e = Engine::new(&chain, predictor(), EngineSettings::default(), 0);
+        e.validated(0);
+        let id = e.model_id();
+        let (tx, rx) = std::sync::mpsc::sync_channel(1);
+        let cmd = Command::swap(predictor(), 0xbeef, tx);
+        let Command::Swap(b) = &cmd else {
+            unreachable!("a swap")
+        };
+        assert!(b.ticket.cancel(), "pending: the sender may cancel");
+        e.command(30, cmd).expect("swap");
+        let back = rx.try_recv().expect("sent back");
+        assert!(!back.swapped && back.model_id == 0xbeef && back.predictor.is_some());
+        assert_eq!(e.model_id(), id, "the running model did not change");
+        assert!(!e.faults().contains(Fault::ModelSwapped));
+        let t = SwapTicket::new();
+        assert!(t.take() && !t.cancel() && !t.take(), "one winner");
     }
 
     #[test]

@@ -160,6 +160,15 @@ impl Engine {
         }
         self.tx.frames()
     }
+
+    /// Safe-stop setpoints for every finger in its current epoch, whatever the state: the
+    /// last round handd sends before it exits (SIGTERM), so no finger keeps an ACTIVE setpoint
+    /// until its controller's own timeout. Changes no latch. No allocation.
+    pub fn shutdown_frames(&mut self) -> &[CanFrame] {
+        self.tx.clear();
+        self.build_setpoints(false);
+        self.tx.frames()
+    }
 }
 
 #[cfg(test)]

@@ -142,18 +142,20 @@ pub struct TestConfig {
 
 impl TestConfig {
     /// Writes `dir/handd.toml` for `model` on the env's interface; `silence_ms` sets both the
-    /// EMG and the finger silence timeouts.
+    /// EMG and the finger silence timeouts. The state directory (the latch file) is `dir`, so
+    /// no test's latches reach another's.
     pub fn write(env: &VcanEnv, dir: &Path, model: &Path, silence_ms: u32) -> Self {
         let path = dir.join("handd.toml");
         let socket = dir.join("handctl.sock");
         let text = format!(
             "interface = \"{}\"\nmodel = \"{}\"\ntick_ms = 50\n\
-             deadline_slack_ms = {DEADLINE_SLACK_MS}\nmains_hz = 50\n\n\
+             deadline_slack_ms = {DEADLINE_SLACK_MS}\nmains_hz = 50\nstate_dir = \"{}\"\n\n\
              [timeouts]\nemg_silence_ms = {silence_ms}\nfinger_silence_ms = {silence_ms}\n\
              recovery_ms = 500\n\n[control]\nsocket = \"{}\"\ngroup = \"root\"\n\
              audit_log = \"{}\"\n",
             env.iface,
             model.display(),
+            dir.display(),
             socket.display(),
             dir.join("audit.log").display()
         );

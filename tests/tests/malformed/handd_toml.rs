@@ -13,6 +13,7 @@ model = "/var/lib/handstack/model.hsm"
 tick_ms = 50
 deadline_slack_ms = 5
 mains_hz = 50
+state_dir = "/var/lib/handstack"
 
 [timeouts]
 emg_silence_ms = 100
@@ -51,6 +52,7 @@ fn is_field(field: &str) -> bool {
         "control.socket",
         "deploy.max_tolerance",
         "deploy.min_rays",
+        "state_dir",
     ];
     const FINGER: &[&str] = &[
         "kf",
