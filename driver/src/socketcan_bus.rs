@@ -52,10 +52,9 @@ mod err {
     pub const CRTL_ACTIVE: u8 = 0x40;
 }
 
-/// `IFF_UP` and `IFF_RUNNING` (the carrier: a CAN controller that is bus-off or stopped has
-/// none) of `/sys/class/net/<if>/flags`.
+/// `IFF_UP` of `/sys/class/net/<if>/flags`. The carrier (a CAN controller that is bus-off or
+/// stopped has none) is `/sys/class/net/<if>/carrier`.
 const IFF_UP: u32 = 0x1;
-const IFF_RUNNING: u32 = 0x40;
 
 /// One error frame (`CAN_ERR_*` bits of its id, its data) applied to the controller's state
 /// and the counters; true when it reports bus-off.
@@ -142,7 +141,9 @@ pub fn interface_up(iface: &str) -> Result<(), TransportError> {
             "CAN interface {iface:?} is down (`ip link set up {iface}`)"
         )));
     }
-    if flags & IFF_RUNNING == 0 {
+    // The carrier (not in `flags`: the kernel computes IFF_RUNNING for ioctl and netlink only).
+    let carrier = std::fs::read_to_string(dir.join("carrier")).unwrap_or_default();
+    if carrier.trim() != "1" {
         return Err(TransportError::Down(format!(
             "CAN interface {iface:?} has no carrier (the controller is bus-off or stopped; \
              `ip -details link show {iface}` shows its state)"
