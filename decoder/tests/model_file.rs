@@ -417,22 +417,26 @@ fn required_sections_are_listed_and_an_unknown_one_is_refused() {
     let bytes = with_stage.to_bytes().unwrap();
     assert_eq!(u32::from_le_bytes(bytes[8..12].try_into().unwrap()), 2);
     let mut p = split(&bytes);
-    assert_eq!(p.meta["required"], serde_json::json!(["rest_stage"]));
+    assert_eq!(
+        p.meta["required"],
+        serde_json::json!(["rest_stage", "envelope"])
+    );
     let load = |b: &[u8]| TrainedModel::from_bytes(b, Some(&chain(2)));
     assert!(load(&join(&p)).is_ok());
     // A newer writer's section this build does not know.
-    p.meta["required"] = serde_json::json!(["rest_stage", "grip_limiter"]);
+    p.meta["required"] = serde_json::json!(["rest_stage", "envelope", "grip_limiter"]);
     let e = load(&join(&p)).unwrap_err();
     assert!(
         matches!(&e, FileError::UnknownRequired { sections } if sections == &["grip_limiter"]),
         "{e}"
     );
     // A version 2 file with a rest stage it does not mark required is malformed.
-    p.meta["required"] = serde_json::json!([]);
+    p.meta["required"] = serde_json::json!(["envelope"]);
     let e = load(&join(&p)).unwrap_err();
     assert!(e.to_string().contains("rest_stage"), "{e}");
     // Version 1 (no `required`): loads, its rest stage applied as before.
     p.meta.as_object_mut().unwrap().remove("required");
+    p.meta.as_object_mut().unwrap().remove("envelope");
     let old = load(&join_version(&p, 1)).expect("a version 1 file loads");
     assert_eq!(old.rest_stage(), with_stage.rest_stage());
 }

@@ -39,6 +39,8 @@ pub struct Counters {
     pub frames_rx: u64,
     /// Frames the daemon sent.
     pub frames_tx: u64,
+    /// Windows beyond the calibration's envelope, held inside it before the model.
+    pub beyond_calibration: u64,
 }
 
 /// One EMG channel.
@@ -131,6 +133,7 @@ impl Live {
                 bad_frames: s.counters.bad_frames,
                 frames_rx: s.frames_rx,
                 frames_tx: s.frames_tx,
+                beyond_calibration: s.counters.beyond_calibration,
             },
             bus_load: s.bus_load,
             bus: crate::protocol::BusStatus {

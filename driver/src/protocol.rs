@@ -105,6 +105,10 @@ pub struct Status {
     pub samples_lost: u64,
     /// Frames with an unknown id or a wrong length since start.
     pub bad_frames: u64,
+    /// Windows beyond the calibration's envelope since start, held inside it before the model
+    /// (absent from a daemon older than this field).
+    #[serde(default)]
+    pub beyond_calibration: u64,
     /// Newest sample frame received -> setpoints written.
     pub latency: Percentiles,
     /// Compute time of the tick.

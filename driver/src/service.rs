@@ -129,6 +129,7 @@ impl ControlHandler {
             deadline_misses: s.counters.deadline_misses,
             samples_lost: s.counters.samples_lost,
             bad_frames: s.counters.bad_frames,
+            beyond_calibration: s.counters.beyond_calibration,
             latency: s.latency,
             compute: s.compute,
             lateness: s.lateness,

@@ -65,7 +65,8 @@ pub fn format_status(s: &Status) -> String {
     let mut out = format_model(s);
     out += &format!(
         "state {}   faults {}\n\
-         ticks {}   deadline misses {}   EMG samples lost {}   bad frames {}\n\
+         ticks {}   deadline misses {}   EMG samples lost {}   bad frames {}   windows beyond \
+         the calibration {}\n\
          latency (newest sample -> setpoints) p50 {} us  p99 {} us  max {} us\n\
          compute per tick                     p50 {} us  p99 {} us  max {} us\n\
          tick start after its deadline        p50 {} us  p99 {} us  max {} us\n\
@@ -79,6 +80,7 @@ pub fn format_status(s: &Status) -> String {
         s.deadline_misses,
         s.samples_lost,
         s.bad_frames,
+        s.beyond_calibration,
         s.latency.p50_us,
         s.latency.p99_us,
         s.latency.max_us,

@@ -20,9 +20,10 @@
 //! raw IEEE-754 doubles so they load bit for bit.
 //!
 //! Versions. Version 2 lists in `required` every metadata section present that changes what
-//! the model outputs (today `rest_stage`, the dead zone at rest); a reader refuses a file whose
-//! `required` names a section it does not know ([`FileError::UnknownRequired`]), so a newer file
-//! is never run with part of its behaviour silently dropped. Sections that only describe the
+//! the model outputs (today `rest_stage`, the dead zone at rest, and `envelope`, the
+//! calibration's envelope its inputs are held inside: [`super::Envelope`]); a reader refuses a
+//! file whose `required` names a section it does not know ([`FileError::UnknownRequired`]), so
+//! a newer file is never run with part of its behaviour silently dropped. Sections that only describe the
 //! model (`verification`, `rest_rms_uv`, the summary) are not required: an older reader may
 //! ignore them. A new section that changes the outputs goes into `required` (and this build's
 //! [`KNOWN_REQUIRED`]); a change of the layout itself bumps [`FORMAT_VERSION`]. This build
@@ -62,7 +63,7 @@ pub const FORMAT_VERSION: u32 = 2;
 /// The oldest format version this build reads.
 pub const OLDEST_VERSION: u32 = 1;
 /// The metadata sections this build knows how to apply, of those a file may mark `required`.
-pub const KNOWN_REQUIRED: &[&str] = &["rest_stage"];
+pub const KNOWN_REQUIRED: &[&str] = &["rest_stage", "envelope"];
 /// Header length in bytes.
 pub const HEADER_LEN: usize = 24;
 /// Name of the normalizer tensor in the metadata and in errors.
@@ -98,6 +99,9 @@ struct Meta {
     /// Absent in older files, and for a model without a rest stage (raw outputs).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     rest_stage: Option<RestStage>,
+    /// Per input feature, the calibration's largest value (absent in older files).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    envelope: Option<Vec<f64>>,
     /// The sections present that change the outputs (version 2 on; see the module docs).
     #[serde(default)]
     required: Vec<String>,
@@ -400,12 +404,15 @@ impl TrainedModel {
             verification: self.verification.clone(),
             rest_rms_uv: self.rest_rms_uv.clone(),
             rest_stage: self.rest_stage,
-            required: self
-                .rest_stage
-                .is_some()
-                .then(|| "rest_stage".to_owned())
-                .into_iter()
-                .collect(),
+            envelope: self.envelope.as_ref().map(|e| e.max().to_vec()),
+            required: [
+                self.rest_stage.is_some().then_some("rest_stage"),
+                self.envelope.is_some().then_some("envelope"),
+            ]
+            .into_iter()
+            .flatten()
+            .map(str::to_owned)
+            .collect(),
         };
         let meta_json =
             serde_json::to_vec_pretty(&meta).map_err(|e| FileError::Malformed(e.to_string()))?;
@@ -448,12 +455,22 @@ impl TrainedModel {
         let model = AnyModel::from_params(meta.kind, &meta.spec, n_in, N_FINGERS, params.to_vec())?;
         let normalizer = Normalizer::from_scales(scales.to_vec())?;
         let trained = TrainedModel::new(model, meta.spec, normalizer, chain, meta.summary)?;
-        with_records(
+        let trained = with_records(
             trained,
             meta.verification,
             meta.rest_rms_uv,
             meta.rest_stage,
-        )
+        )?;
+        match meta.envelope {
+            Some(max) => {
+                let envelope = super::Envelope::try_new(max)
+                    .map_err(|e| FileError::Malformed(format!("envelope: {e}")))?;
+                trained
+                    .with_envelope(Some(envelope))
+                    .map_err(|e| FileError::Malformed(format!("envelope: {e}")))
+            }
+            None => Ok(trained),
+        }
     }
 
     /// Writes the model atomically ([`crate::fsio::write_atomic`]: a temporary file in the same

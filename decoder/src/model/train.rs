@@ -430,6 +430,10 @@ pub fn train(
         n_val_trials: distinct_trials(data, &split.val),
         duration_ms: u64::try_from(started.elapsed().as_millis()).unwrap_or(u64::MAX),
     };
-    let trained = TrainedModel::new(model, *spec, normalizer, data.chain().clone(), summary)?;
+    // Every window of the calibration (the validation part too: it is the patient's signal all
+    // the same) bounds what the model may see.
+    let envelope = super::Envelope::fit(nf, (0..data.len()).map(|i| data.row(i)))?;
+    let trained = TrainedModel::new(model, *spec, normalizer, data.chain().clone(), summary)?
+        .with_envelope(Some(envelope))?;
     Ok(super::rest::with_fitted_rest(trained, data, cfg.rest)?)
 }

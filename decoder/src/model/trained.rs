@@ -5,6 +5,7 @@ use crate::dsp::{ChainConfig, FEATURES_PER_CHANNEL};
 
 use super::any::AnyModel;
 use super::dataset::N_FINGERS;
+use super::envelope::Envelope;
 use super::error::ModelError;
 use super::normalizer::Normalizer;
 use super::rest::RestStage;
@@ -26,6 +27,7 @@ pub struct TrainedModel {
     pub(crate) verification: Option<VerificationRecord>,
     pub(crate) rest_rms_uv: Option<Vec<f64>>,
     pub(crate) rest_stage: Option<RestStage>,
+    pub(crate) envelope: Option<Envelope>,
 }
 
 impl TrainedModel {
@@ -81,7 +83,30 @@ impl TrainedModel {
             verification: None,
             rest_rms_uv: None,
             rest_stage: None,
+            envelope: None,
         })
+    }
+
+    /// The model with `envelope` applied to its inputs (see [`Envelope`]), or without one (an
+    /// older file: inputs beyond the calibration reach the model as they are). Refuses an
+    /// envelope of another input count.
+    pub fn with_envelope(mut self, envelope: Option<Envelope>) -> Result<Self, ModelError> {
+        if let Some(e) = &envelope {
+            if e.len() != self.normalizer.len() {
+                return Err(ModelError::Shape {
+                    what: "envelope (one value per input feature)".into(),
+                    expected: self.normalizer.len(),
+                    found: e.len(),
+                });
+            }
+        }
+        self.envelope = envelope;
+        Ok(self)
+    }
+
+    /// The calibration's envelope its inputs are held inside (None: an older file).
+    pub fn envelope(&self) -> Option<&Envelope> {
+        self.envelope.as_ref()
     }
 
     /// The model with `record` as its verification (replacing any earlier one). Refuses a
@@ -171,14 +196,7 @@ impl TrainedModel {
     /// Labels for one raw feature vector (normalized here). Allocates scratch; for offline use
     /// (the daemon uses a [`Predictor`]). Panics if `features` has the wrong length.
     pub fn predict(&self, features: &[f64]) -> [f64; N_FINGERS] {
-        let mut xn = vec![0.0; self.normalizer.len()];
-        self.normalizer.apply(features, &mut xn);
-        let mut y = [0.0; N_FINGERS];
-        self.model.predict(&xn, &mut y);
-        if let Some(stage) = &self.rest_stage {
-            stage.apply(&mut y);
-        }
-        y
+        self.predictor().run(features)
     }
 
     /// Labels for many raw feature vectors stored row-major in `rows` (e.g. a
@@ -201,21 +219,30 @@ impl TrainedModel {
             model: self.model.clone(),
             normalizer: self.normalizer.clone(),
             rest_stage: self.rest_stage,
+            envelope: self.envelope.clone(),
             scratch: self.model.new_scratch(),
+            xp: vec![0.0; self.normalizer.len()],
             xn: vec![0.0; self.normalizer.len()],
+            last_scale: 1.0,
+            last_implausible: false,
         }
     }
 }
 
-/// Runs a trained model on raw feature vectors without allocating: normalize, predict, then
-/// the rest stage when the model has one.
+/// Runs a trained model on raw feature vectors without allocating: the envelope when the model
+/// has one, normalize, predict, then the rest stage when the model has one.
 #[derive(Debug, Clone)]
 pub struct Predictor {
     model: AnyModel,
     normalizer: Normalizer,
     rest_stage: Option<RestStage>,
+    envelope: Option<Envelope>,
     scratch: Scratch,
+    /// The features held inside the envelope.
+    xp: Vec<f64>,
     xn: Vec<f64>,
+    last_scale: f64,
+    last_implausible: bool,
 }
 
 impl Predictor {
@@ -230,12 +257,35 @@ impl Predictor {
     /// reports such input as a fault before it gets here.
     #[inline]
     pub fn run(&mut self, features: &[f64]) -> [f64; N_FINGERS] {
-        self.normalizer.apply(features, &mut self.xn);
+        match &self.envelope {
+            Some(e) => {
+                self.last_implausible = e.implausible(features);
+                if self.last_implausible {
+                    self.last_scale = 0.0;
+                    return [0.0; N_FINGERS];
+                }
+                self.last_scale = e.project(features, &mut self.xp);
+                self.normalizer.apply(&self.xp, &mut self.xn);
+            }
+            None => self.normalizer.apply(features, &mut self.xn),
+        }
         let mut y = [0.0; N_FINGERS];
         self.model.predict_with(&self.xn, &mut y, &mut self.scratch);
         if let Some(stage) = &self.rest_stage {
             stage.apply(&mut y);
         }
         y
+    }
+
+    /// The signal scale the envelope applied to the last window (1: inside the calibration,
+    /// or no envelope).
+    pub fn last_scale(&self) -> f64 {
+        self.last_scale
+    }
+
+    /// Whether the last window was implausible (one channel beyond the calibration while the
+    /// others are not: see [`Envelope::implausible`]); its output was rest.
+    pub fn last_implausible(&self) -> bool {
+        self.last_implausible
     }
 }

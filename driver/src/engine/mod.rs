@@ -91,6 +91,10 @@ pub struct Counters {
     pub e2e_errors: u64,
     /// E-stop frames received.
     pub estops: u64,
+    /// Windows beyond the calibration's envelope, moved back into it before the model
+    /// (`decoder::model::Envelope`): a stronger grip than the calibration's, or an electrode
+    /// far above its calibrated level.
+    pub beyond_calibration: u64,
 }
 
 /// Requests from technicians, applied at the next tick.
@@ -323,6 +327,14 @@ impl Engine {
         }
         self.samples_used = self.emg.samples_in;
         let y = predictor.run(self.emg.chain.features());
+        if predictor.last_scale() < 1.0 {
+            self.counters.beyond_calibration += 1;
+        }
+        // One channel beyond the calibration while the others are not: a pressed or lifted
+        // electrode, not an effort. The predictor gave rest; the hand stops while it lasts.
+        if predictor.last_implausible() {
+            self.raise(now_us, Fault::SignalQuality);
+        }
         if y.iter().all(|v| v.is_finite()) {
             self.labels = y;
         } else {
