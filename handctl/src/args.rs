@@ -40,8 +40,10 @@ pub enum Command {
     Status(StatusArgs),
     /// Change one finger's kF and/or kα on the running daemon (saved to its config).
     Tune(TuneArgs),
-    /// Clear latched faults (E-stop, bus-off, repeated E2E errors, stop).
-    Arm(DaemonOpts),
+    /// Clear latched faults (E-stop, bus-off, repeated E2E errors, stop), once the last second
+    /// of the patient at rest shows the electrodes where the running model's calibration had
+    /// them.
+    Arm(ArmArgs),
     /// Safe-stop every finger until `handctl arm`.
     Stop(DaemonOpts),
     /// Swap a model into the running daemon at a tick boundary, without a restart (checked
@@ -73,6 +75,17 @@ pub struct DaemonOpts {
     /// handd's config file, to find the socket (default /etc/handstack/handd.toml).
     #[arg(long)]
     pub config: Option<PathBuf>,
+}
+
+/// `handctl arm`.
+#[derive(Debug, Args)]
+pub struct ArmArgs {
+    /// Arm although the live rest pattern per channel differs from the running model's
+    /// calibration (swapped or shifted electrodes?); recorded in handd's audit log.
+    #[arg(long)]
+    pub force_rest_mismatch: bool,
+    #[command(flatten)]
+    pub daemon: DaemonOpts,
 }
 
 /// `handctl status`.
