@@ -32,6 +32,8 @@ use crate::units::{FINGER_NAMES, N_FINGERS};
 
 /// EMG channels a snapshot holds (the bus's).
 pub const SNAPSHOT_CHANNELS: usize = hand_dbc::emg::EMG_CHANNELS;
+/// Ticks of per-channel RMS a snapshot keeps (one second at 50 ms a tick).
+pub const RMS_HISTORY: usize = 20;
 
 /// What `handctl status` and the live subscription show, copied out of the loop every tick
 /// without allocating.
@@ -71,6 +73,11 @@ pub struct Snapshot {
     pub channels: usize,
     /// Per channel, the RMS feature the model last ran on, µV.
     pub channel_rms_uv: [f64; SNAPSHOT_CHANNELS],
+    /// `channel_rms_uv` of the last [`RMS_HISTORY`] ticks (a ring, in no particular order):
+    /// `arm` takes the live rest level from it ([`crate::rest_check`]) without waiting.
+    pub rms_history: [[f64; SNAPSHOT_CHANNELS]; RMS_HISTORY],
+    /// Entries of `rms_history` filled so far (at most [`RMS_HISTORY`]).
+    pub rms_history_len: usize,
     /// The amplifier's last lead-off mask (bit c = channel c).
     pub lead_off_mask: u16,
     /// The amplifier's last saturation mask.
@@ -108,6 +115,8 @@ impl Default for Snapshot {
             active: [false; N_FINGERS],
             channels: 0,
             channel_rms_uv: [0.0; SNAPSHOT_CHANNELS],
+            rms_history: [[0.0; SNAPSHOT_CHANNELS]; RMS_HISTORY],
+            rms_history_len: 0,
             lead_off_mask: 0,
             saturation_mask: 0,
             frames_rx: 0,
@@ -203,6 +212,10 @@ pub struct Runner<T: Transport, K: Clock> {
     latches: Option<crate::persist::LatchPublisher>,
     /// The bus has not been open yet in this process (started with it down).
     never_opened: bool,
+    /// The last ticks' per-channel RMS, for the snapshot ([`Snapshot::rms_history`]).
+    rms_history: [[f64; SNAPSHOT_CHANNELS]; RMS_HISTORY],
+    /// Ticks written into `rms_history` (its next slot is this modulo [`RMS_HISTORY`]).
+    rms_ticks: usize,
 }
 
 impl<T: Transport, K: Clock> Runner<T, K> {
@@ -232,6 +245,8 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             carried: true,
             spin_us: 0,
             failure_log: LogLimit::default(),
+            rms_history: [[0.0; SNAPSHOT_CHANNELS]; RMS_HISTORY],
+            rms_ticks: 0,
             reopen_log: LogLimit::default(),
             amp_problem: None,
             latches: None,
@@ -598,6 +613,16 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         let per = decoder::dsp::FEATURES_PER_CHANNEL;
         let channels = e.n_channels().min(SNAPSHOT_CHANNELS);
         let (lead_off_mask, saturation_mask) = e.amp_masks();
+        // RMS is the first feature of each channel (decoder::dsp::FEATURE_NAMES).
+        let channel_rms_uv: [f64; SNAPSHOT_CHANNELS] = std::array::from_fn(|c| {
+            if c < channels {
+                features.get(c * per).copied().unwrap_or(0.0)
+            } else {
+                0.0
+            }
+        });
+        self.rms_history[self.rms_ticks % RMS_HISTORY] = channel_rms_uv;
+        self.rms_ticks = self.rms_ticks.wrapping_add(1);
         let snap = Snapshot {
             t_us: deadline,
             state: e.state(),
@@ -615,14 +640,9 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             reported_position: *e.reported_position(),
             active: std::array::from_fn(|f| e.finger_active(f)),
             channels,
-            // RMS is the first feature of each channel (decoder::dsp::FEATURE_NAMES).
-            channel_rms_uv: std::array::from_fn(|c| {
-                if c < channels {
-                    features.get(c * per).copied().unwrap_or(0.0)
-                } else {
-                    0.0
-                }
-            }),
+            channel_rms_uv,
+            rms_history: self.rms_history,
+            rms_history_len: self.rms_ticks.min(RMS_HISTORY),
             lead_off_mask,
             saturation_mask,
             frames_rx: self.frames_rx,

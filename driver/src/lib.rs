@@ -20,6 +20,7 @@ pub mod mem_transport;
 pub mod model_service;
 pub mod persist;
 pub mod protocol;
+pub mod rest_check;
 pub mod rt;
 pub mod rx_times;
 pub mod safety;

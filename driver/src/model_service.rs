@@ -149,22 +149,23 @@ impl ControlHandler {
         self.after_swap("rollback", &status, &previous, &path, peer, user, false)
     }
 
-    /// The live lines name the model now running, with its file's rest levels (read here, on
-    /// the control thread; a file that no longer reads gives none: they are for display only).
-    fn tell_live(&self, status: &ModelStatus) {
+    /// The running model's calibration rest levels, read from its file here on the control
+    /// thread (a file that no longer reads gives none), kept for `arm`'s rest check and told
+    /// to the live lines with the model's name.
+    fn tell_live(&mut self, status: &ModelStatus) {
+        self.model_rest = decoder::model::TrainedModel::load(&status.path, None)
+            .ok()
+            .and_then(|m| m.rest_rms_uv().map(<[f64]>::to_vec));
         let Some(live) = &self.live_model else {
             return;
         };
-        let rest_rms_uv = decoder::model::TrainedModel::load(&status.path, None)
-            .ok()
-            .and_then(|m| m.rest_rms_uv().map(<[f64]>::to_vec));
         *live.lock().unwrap_or_else(|e| e.into_inner()) = crate::control::LiveModel {
             info: crate::live::ModelInfo {
                 id: status.id.clone(),
                 path: status.path.clone(),
                 kind: status.kind.clone(),
             },
-            rest_rms_uv,
+            rest_rms_uv: self.model_rest.clone(),
         };
     }
 
@@ -362,11 +363,16 @@ mod tests {
             Some(true),
             "on disk when stop answers"
         );
-        let m = message(&handler.handle(Request::Arm, ROOT));
+        let m = message(&handler.handle(
+            Request::Arm {
+                force_rest_mismatch: false,
+            },
+            ROOT,
+        ));
         assert!(m.starts_with("armed"), "{m}");
         let lines = audit_lines(&config.control.audit_log);
         assert_eq!(lines.len(), 2, "{lines:?}");
-        for (line, action) in lines.iter().zip(["stop", "arm"]) {
+        for (line, action) in lines.iter().zip(["stop", "arm rest=unchecked"]) {
             assert!(
                 line.starts_with("time=") && line.contains(" mono=") && line.ends_with(action),
                 "{line}"

@@ -23,8 +23,13 @@ pub enum Request {
         #[serde(default, skip_serializing_if = "Option::is_none")]
         kalpha: Option<f64>,
     },
-    /// Clear latched faults.
-    Arm,
+    /// Clear latched faults, once the live rest pattern per channel matches the running
+    /// model's calibration ([`crate::rest_check`]); the patient must be at rest.
+    Arm {
+        /// Arm although the live rest pattern differs from the calibration's (audited).
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        force_rest_mismatch: bool,
+    },
     /// Go to SAFE and stay there until `arm`.
     Stop,
     /// Stream one [`crate::live::Live`] line every `every_ms` (rounded to whole ticks) until
@@ -244,12 +249,9 @@ impl Request {
     /// The fields this command takes besides `cmd`.
     fn fields(&self) -> &'static [&'static str] {
         match self {
-            Request::Status
-            | Request::Arm
-            | Request::Stop
-            | Request::Calibrating
-            | Request::Rollback => &[],
+            Request::Status | Request::Stop | Request::Calibrating | Request::Rollback => &[],
             Request::Deploy { .. } => &["path", "force"],
+            Request::Arm { .. } => &["force_rest_mismatch"],
             Request::Tune { .. } => &["finger", "kf", "kalpha"],
             Request::Subscribe { .. } => &["every_ms"],
         }
@@ -264,7 +266,12 @@ mod tests {
     fn requests_round_trip() {
         for r in [
             Request::Status,
-            Request::Arm,
+            Request::Arm {
+                force_rest_mismatch: false,
+            },
+            Request::Arm {
+                force_rest_mismatch: true,
+            },
             Request::Stop,
             Request::Subscribe { every_ms: None },
             Request::Subscribe {

@@ -22,6 +22,12 @@ use crate::safety::Fault;
 use crate::tuning::{commit_tune, plan_tune, user_name};
 use crate::units::{FINGER_NAMES, N_FINGERS};
 
+/// What the rest check before `arm` found: for the audit line and for the reply.
+struct RestOutcome {
+    audit: String,
+    said: String,
+}
+
 /// Commands waiting for the loop at most; make the channel with
 /// `std::sync::mpsc::sync_channel(COMMAND_QUEUE)`.
 pub const COMMAND_QUEUE: usize = 16;
@@ -47,6 +53,9 @@ pub struct ControlHandler {
     latches: Option<LatchStore>,
     /// How long a deploy or rollback waits for the loop to take the model.
     pub(crate) swap_wait: std::time::Duration,
+    /// The running model's calibration rest level per channel (µV), when its file keeps it:
+    /// `arm` compares the live rest pattern with it ([`crate::rest_check`]).
+    pub(crate) model_rest: Option<Vec<f64>>,
 }
 
 impl ControlHandler {
@@ -75,7 +84,15 @@ impl ControlHandler {
             live_model: None,
             latches: None,
             swap_wait: crate::model_service::SWAP_WAIT,
+            model_rest: None,
         }
+    }
+
+    /// The handler, for a running model whose file keeps these calibration rest levels (see
+    /// [`decoder::model::TrainedModel::rest_rms_uv`]); `arm` compares the live ones with them.
+    pub fn with_rest_levels(mut self, levels: Option<Vec<f64>>) -> Self {
+        self.model_rest = levels;
+        self
     }
 
     /// The handler, for a loop whose latches are kept by `store` (`crate::persist`), starting
@@ -174,7 +191,9 @@ impl ControlHandler {
             Request::Calibrating => self.calibrating(peer, &user),
             Request::Deploy { path, force } => self.deploy(&path, force, peer, &user),
             Request::Rollback => self.rollback(peer, &user),
-            Request::Arm => self.arm(peer, &user),
+            Request::Arm {
+                force_rest_mismatch,
+            } => self.arm(peer, &user, force_rest_mismatch),
             Request::Subscribe { .. } => Reply::Refused {
                 reason: "subscribe is served by the control socket, not by this handler".into(),
             },
@@ -214,8 +233,10 @@ impl ControlHandler {
         }
     }
 
-    /// `arm`, refused while calibrating (until a deploy or rollback) and without a model.
-    fn arm(&mut self, peer: Peer, user: &str) -> Reply {
+    /// `arm`, refused while calibrating (until a deploy or rollback) and without a model, and
+    /// refused when the live rest pattern differs from the running model's calibration unless
+    /// `force_rest_mismatch` (audited).
+    fn arm(&mut self, peer: Peer, user: &str, force_rest_mismatch: bool) -> Reply {
         let refused = match (self.hold, self.no_model) {
             (Hold::Calibrating, _) => Some(crate::safety::ArmError::Calibrating),
             (_, true) => Some(crate::safety::ArmError::NoModel),
@@ -226,20 +247,100 @@ impl ControlHandler {
                 reason: e.to_string(),
             };
         }
+        let rest = match self.rest_check(force_rest_mismatch) {
+            Ok(r) => r,
+            Err(reason) => {
+                tracing::warn!(user, "arm refused: {reason}");
+                return Reply::Refused { reason };
+            }
+        };
         match self.send(Command::Arm) {
             Ok(()) => {
                 self.hold = Hold::Free;
-                audit(&self.config.control.audit_log, user, peer, "arm");
-                tracing::warn!(user, "armed by a technician");
+                audit(
+                    &self.config.control.audit_log,
+                    user,
+                    peer,
+                    &format!("arm {}", rest.audit),
+                );
+                tracing::warn!(user, rest = %rest.audit, "armed by a technician");
                 Reply::Ok {
-                    message:
-                        "armed: latched faults cleared; the hand moves after 500 ms of good signal"
-                            .into(),
+                    message: format!(
+                        "armed: latched faults cleared; the hand moves after 500 ms of good \
+                         signal; {}",
+                        rest.said
+                    ),
                     status: None,
                 }
             }
             Err(r) => *r,
         }
+    }
+
+    /// The rest check before `arm` ([`crate::rest_check`]) on the loop's last second: what to
+    /// audit and say when the hand may be armed, the refusal otherwise.
+    fn rest_check(&self, force: bool) -> Result<RestOutcome, String> {
+        use crate::rest_check::{compare, live_levels};
+        let Some(file) = &self.model_rest else {
+            return Ok(RestOutcome {
+                audit: "rest=unchecked".into(),
+                said: "the running model's file keeps no rest levels: the live signal was not \
+                       compared with its calibration"
+                    .into(),
+            });
+        };
+        let override_hint = "; nothing changed. Check the electrodes and that the patient is \
+                             at rest, then arm again; `handctl arm --force-rest-mismatch` \
+                             arms anyway (audited)";
+        let snap = *self.snapshot.lock().unwrap_or_else(|e| e.into_inner());
+        let checked = live_levels(&snap).and_then(|live| compare(file, &live));
+        let c = match checked {
+            Ok(c) => c,
+            Err(e) if force => {
+                return Ok(RestOutcome {
+                    audit: "rest=FORCED-unchecked".into(),
+                    said: format!("WARNING: armed without the rest check ({e})"),
+                })
+            }
+            Err(e) => return Err(format!("rest check: {e}{override_hint}")),
+        };
+        if c.matches() {
+            return Ok(RestOutcome {
+                audit: format!("rest=match level={:.2}", c.level),
+                said: format!(
+                    "the live rest pattern matches the calibration ({})",
+                    c.summary()
+                ),
+            });
+        }
+        let channels: Vec<String> = c.differing.iter().map(usize::to_string).collect();
+        let channels = if channels.is_empty() {
+            "pattern".to_owned()
+        } else {
+            channels.join(",")
+        };
+        if force {
+            return Ok(RestOutcome {
+                audit: format!(
+                    "rest=MISMATCH-forced channels={channels} level={:.2}",
+                    c.level
+                ),
+                said: format!(
+                    "WARNING: armed although the live rest pattern differs from the \
+                     calibration: {} ({})",
+                    c.differences(),
+                    c.summary()
+                ),
+            });
+        }
+        Err(format!(
+            "the live rest pattern differs from the running model's calibration: {} ({}). \
+             Swapped or shifted electrodes, or a model from another fitting, look like this; so \
+             does a patient who is not at rest (arm compares the second before it was asked: \
+             the patient must be relaxed){override_hint}",
+            c.differences(),
+            c.summary()
+        ))
     }
 
     /// `tune`: checked completely, saved, then handed to the loop; refused with nothing

@@ -40,8 +40,10 @@ pub enum Command {
     Status(StatusArgs),
     /// Change one finger's kF and/or kα on the running daemon (saved to its config).
     Tune(TuneArgs),
-    /// Clear latched faults (E-stop, bus-off, repeated E2E errors, stop).
-    Arm(DaemonOpts),
+    /// Clear latched faults (E-stop, bus-off, repeated E2E errors, stop), once the last second
+    /// of the patient at rest shows the electrodes where the running model's calibration had
+    /// them.
+    Arm(ArmArgs),
     /// Safe-stop every finger until `handctl arm`.
     Stop(DaemonOpts),
     /// Swap a model into the running daemon at a tick boundary, without a restart (checked
@@ -73,6 +75,17 @@ pub struct DaemonOpts {
     /// handd's config file, to find the socket (default /etc/handstack/handd.toml).
     #[arg(long)]
     pub config: Option<PathBuf>,
+}
+
+/// `handctl arm`.
+#[derive(Debug, Args)]
+pub struct ArmArgs {
+    /// Arm although the live rest pattern per channel differs from the running model's
+    /// calibration (swapped or shifted electrodes?); recorded in handd's audit log.
+    #[arg(long)]
+    pub force_rest_mismatch: bool,
+    #[command(flatten)]
+    pub daemon: DaemonOpts,
 }
 
 /// `handctl status`.
@@ -302,6 +315,16 @@ pub struct VerifyArgs {
     pub tolerance: f64,
 }
 
+fn parse_resume_age(s: &str) -> Result<u64, String> {
+    let max = crate::calibrate::resume_check::MAX_RESUME_AGE_MIN;
+    let v: u64 = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
+    if (1..=max).contains(&v) {
+        Ok(v)
+    } else {
+        Err(format!("{v}: must be 1 to {max} minutes"))
+    }
+}
+
 fn parse_tolerance(s: &str) -> Result<f64, String> {
     let v: f64 = s.parse().map_err(|e| format!("{s:?}: {e}"))?;
     if v.is_finite() && v >= 0.0 {
@@ -487,9 +510,17 @@ pub struct CalibrateArgs {
     /// No questions; plain progress lines instead of the live screen.
     #[arg(long)]
     pub yes: bool,
-    /// Continue an interrupted calibration in --out from its next trial.
+    /// Continue an interrupted calibration in --out from its next trial (after 3 s of the
+    /// patient relaxed, compared with the session's rest trials).
     #[arg(long)]
     pub resume: bool,
+    /// With --resume: refuse a session that started longer ago than this, minutes (1 to 1440).
+    #[arg(long, default_value_t = crate::calibrate::resume_check::DEFAULT_MAX_RESUME_AGE_MIN, value_parser = parse_resume_age)]
+    pub max_resume_age_min: u64,
+    /// With --resume: go on although the live rest pattern per channel differs from the
+    /// session's rest trials (swapped or shifted electrodes?).
+    #[arg(long, requires = "resume")]
+    pub force_rest_mismatch: bool,
     /// Mains frequency written into the session's chain settings, 50 or 60 Hz.
     #[arg(long, default_value_t = 50, value_parser = parse_mains)]
     pub mains: u32,

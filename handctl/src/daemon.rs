@@ -8,7 +8,7 @@ use driver::control::{request, ControlError};
 use driver::protocol::{Reply, Request, Status};
 use driver::units::FINGER_NAMES;
 
-use super::args::{DaemonOpts, TuneArgs};
+use super::args::{ArmArgs, DaemonOpts, TuneArgs};
 use super::error::CliError;
 
 /// The socket to talk to: `--socket`, else the one named in the config file, else the default.
@@ -159,9 +159,16 @@ pub fn tune(a: &TuneArgs) -> Result<(), CliError> {
     .map(drop)
 }
 
-/// `handctl arm`.
-pub fn arm(o: &DaemonOpts) -> Result<(), CliError> {
-    done(ask(o, &Request::Arm)?).map(drop)
+/// `handctl arm`: handd first compares the last second of the patient at rest with the
+/// running model's calibration.
+pub fn arm(a: &ArmArgs) -> Result<(), CliError> {
+    done(ask(
+        &a.daemon,
+        &Request::Arm {
+            force_rest_mismatch: a.force_rest_mismatch,
+        },
+    )?)
+    .map(drop)
 }
 
 /// `handctl stop`.

@@ -48,7 +48,7 @@ fn main() -> ExitCode {
         Command::Decode(a) => decode::run(a),
         Command::Status(a) => daemon::status(&a.daemon, a.json),
         Command::Tune(a) => daemon::tune(a),
-        Command::Arm(o) => daemon::arm(o),
+        Command::Arm(a) => daemon::arm(a),
         Command::Stop(o) => daemon::stop(o),
         Command::Deploy(a) => deploy::deploy(a),
         Command::Rollback(o) => deploy::rollback(o),

@@ -294,7 +294,9 @@ fn calibrating_hold_deploy_refusals_swap_and_rollback() {
     // The hold: safe stops only from the next tick, arm refused.
     let held_from = rig.clock_now();
     assert!(matches!(ask(Request::Calibrating), Reply::Ok { .. }));
-    match ask(Request::Arm) {
+    match ask(Request::Arm {
+        force_rest_mismatch: false,
+    }) {
         Reply::Refused { reason } => assert!(reason.contains("calibrating"), "{reason}"),
         r => panic!("arm during the hold: {r:?}"),
     }
@@ -396,7 +398,12 @@ fn calibrating_hold_deploy_refusals_swap_and_rollback() {
 
     // arm now releases the hand.
     assert!(
-        matches!(ask(Request::Arm), Reply::Ok { .. }),
+        matches!(
+            ask(Request::Arm {
+                force_rest_mismatch: false,
+            }),
+            Reply::Ok { .. }
+        ),
         "arm after the deploy"
     );
     rig.run_until(until + 2_000_000);
@@ -422,7 +429,12 @@ fn calibrating_hold_deploy_refusals_swap_and_rollback() {
         "the hand moved under the rolled-back model before arm"
     );
     assert!(
-        matches!(ask(Request::Arm), Reply::Ok { .. }),
+        matches!(
+            ask(Request::Arm {
+                force_rest_mismatch: false,
+            }),
+            Reply::Ok { .. }
+        ),
         "arm after the rollback"
     );
     rig.run_until(until + 2_000_000);

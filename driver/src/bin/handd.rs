@@ -306,7 +306,8 @@ fn spawn_control(
     )
     .with_chain(chain)
     .with_live_model(live_model)
-    .with_latches(latches, hold);
+    .with_latches(latches, hold)
+    .with_rest_levels(loaded.and_then(|l| l.model.rest_rms_uv().map(<[f64]>::to_vec)));
     let mut handler = match loaded {
         Some(l) => handler.with_model(l.status(&config.model)),
         None => handler.without_model(),

@@ -56,11 +56,20 @@ mod tests {
                 status: None,
             })
         });
-        let reply = request(&path, &Request::Arm).unwrap();
+        let reply = request(
+            &path,
+            &Request::Arm {
+                force_rest_mismatch: false,
+            },
+        )
+        .unwrap();
         let Reply::Ok { message, .. } = reply else {
             panic!("refused: {reply:?}")
         };
-        assert!(message.starts_with("Arm from uid"), "{message}");
+        assert!(
+            message.starts_with("Arm { force_rest_mismatch: false } from uid"),
+            "{message}"
+        );
         // A malformed line is refused with a reason.
         let mut s = UnixStream::connect(&path).unwrap();
         s.write_all(b"{\"cmd\":\"fly\"}\n").unwrap();

@@ -83,7 +83,7 @@ pub fn check_trial(
 
 /// The stretches of `r` holding `trials` (each from [`WARMUP_US`] before it, overlapping
 /// ones merged) as segments, and a recording of those samples alone.
-fn stretches(r: &Recording, trials: &[Trial]) -> (Vec<Segment>, Recording) {
+pub(super) fn stretches(r: &Recording, trials: &[Trial]) -> (Vec<Segment>, Recording) {
     let mut spans: Vec<(u64, u64)> = trials
         .iter()
         .map(|t| (t.start_us.saturating_sub(WARMUP_US), t.end_us))

@@ -112,6 +112,8 @@ fn run(
         iface: "mem0".into(),
         chain: super::chain(50),
         resume,
+        max_resume_age_min: super::resume_check::DEFAULT_MAX_RESUME_AGE_MIN,
+        force_rest_mismatch: false,
     };
     let mut out = Output::new(Mode::Quiet, 10);
     record_session(&mut bus, &mut sim, &plan, &mut out, &stop)
@@ -129,7 +131,24 @@ fn the_cued_patient_is_calibrated_in_memory_the_weak_trial_repeated_and_a_ctrl_c
     assert_eq!((kept, next), (3, 4));
     let partial = Session::open(&dir).expect("a consistent partial session");
     assert_eq!(partial.meta.trials.len(), 3);
-    // Resumed later on the same log (the amplifier restarted: a gap in the recording).
+    // Three hours later it is no longer the same fitting: refused, its age named, the log
+    // untouched.
+    let log = std::fs::metadata(dir.join("frames.log"))
+        .expect("log")
+        .len();
+    let late = run(&dir, 3 * 3_600_000_000 + 2_000_000, None, true);
+    let Err(CalibrateError::Resume(why)) = late else {
+        panic!("expected the age refusal, got {late:?}")
+    };
+    assert!(why.contains("started 3 h 00 min ago"), "{why}");
+    assert_eq!(
+        std::fs::metadata(dir.join("frames.log"))
+            .expect("log")
+            .len(),
+        log
+    );
+    // Resumed later on the same log (the amplifier restarted: a gap in the recording), after
+    // the live rest is compared with the session's rest trial.
     let done = run(&dir, 30_000_000, None, true).expect("the rest of the protocol");
     assert_eq!(done.kept, 10);
     // The weak attempt was caught once, by the repetition gate, and repeated.

@@ -7,7 +7,7 @@
 //! - [`recorder`]: the candump log and the live level trace (the monitor's frame decoder);
 //!   [`placement`]: each trial placed from its cue times and the measured onset;
 //! - [`check`]: the quality gates on each attempt; [`store`]: the session on disk after every
-//!   kept trial, and `--resume`;
+//!   kept trial, and `--resume`; [`resume_check`]: `--resume`'s age limit and rest check;
 //! - [`workflow`]: the loop over a [`workflow::Transport`] and a [`workflow::Pace`] (shared by
 //!   the command and the in-memory test); [`socket`]: SocketCAN and the wall clock;
 //! - [`link`]: the calibrating hold asked of a running handd;
@@ -22,6 +22,7 @@ pub mod output;
 pub mod placement;
 pub mod protocol;
 pub mod recorder;
+pub mod resume_check;
 pub mod sequencer;
 pub mod socket;
 pub mod store;
@@ -86,6 +87,8 @@ pub fn run(a: &CalibrateArgs) -> Result<(), CliError> {
         iface: a.iface.clone(),
         chain: chain(a.mains),
         resume: a.resume,
+        max_resume_age_min: a.max_resume_age_min,
+        force_rest_mismatch: a.force_rest_mismatch,
     };
     let done = workflow::record_session(&mut bus, &mut socket::WallClock, &plan, &mut out, &stop)?;
     // From here on Ctrl-C ends the process at once (the model file is written atomically).

@@ -13,13 +13,14 @@ use decoder::dsp::ChainConfig;
 use decoder::session::{Recording, Trial, TrialKind};
 use hand_dbc::CanFrame;
 
-use super::check::check_trial;
+use super::check::{check_trial, WARMUP_US};
 use super::cue::CueSender;
 use super::error::CalibrateError;
 use super::output::Output;
 use super::placement::{mean_level, place};
 use super::protocol::Protocol;
 use super::recorder::Recorder;
+use super::resume_check::{check_age, check_rest, REST_CHECK_US};
 use super::sequencer::{Event, HoldTimes, Phase, Sequencer};
 use super::store::Store;
 
@@ -59,6 +60,10 @@ pub struct Plan {
     pub chain: ChainConfig,
     /// Continue the calibration in `dir`.
     pub resume: bool,
+    /// With `resume`: a session that started longer ago than this (minutes) is refused.
+    pub max_resume_age_min: u64,
+    /// With `resume`: go on although the live rest pattern differs from the session's.
+    pub force_rest_mismatch: bool,
 }
 
 /// One attempt that failed its check.
@@ -120,7 +125,17 @@ pub fn record_session(
     } else {
         None
     };
-    let rec = Recorder::open(&plan.dir, &plan.iface, &settings, resumed)?;
+    if let Some(r) = &resumed {
+        check_age(
+            r.time_us.first().copied(),
+            clock.now_us(),
+            plan.max_resume_age_min,
+        )?;
+    }
+    let mut rec = Recorder::open(&plan.dir, &plan.iface, &settings, resumed)?;
+    if plan.resume {
+        rest_at_resume(bus, clock, &mut rec, &store, plan, out, stop)?;
+    }
     let now = clock.now_us();
     let seq = Sequencer::new(&protocol, store.kept(), now);
     let mut run = Run {
@@ -145,6 +160,54 @@ pub fn record_session(
     run.done.kept = run.store.kept();
     run.done.frames = run.rec.frames();
     Ok(run.done)
+}
+
+/// Before the first cue of a resumed calibration: [`REST_CHECK_US`] of the patient relaxed,
+/// recorded (into the log too) and compared with the session's kept rest trials
+/// ([`check_rest`]); refused when the pattern differs, unless `--force-rest-mismatch`.
+fn rest_at_resume(
+    bus: &mut impl Transport,
+    clock: &mut impl Pace,
+    rec: &mut Recorder,
+    store: &Store,
+    plan: &Plan,
+    out: &mut Output,
+    stop: &AtomicBool,
+) -> Result<(), CalibrateError> {
+    out.say(&format!(
+        "resuming: keep the patient relaxed for {} s while the rest level is compared with the \
+         session's",
+        REST_CHECK_US / 1_000_000
+    ));
+    let from = clock.now_us();
+    let end = from + REST_CHECK_US;
+    loop {
+        while let Some((f, t)) = bus.receive()? {
+            rec.on_frame(&f, t)?;
+        }
+        let now = clock.now_us();
+        if stop.load(Ordering::Relaxed) {
+            rec.flush()?;
+            return Err(CalibrateError::Interrupted {
+                dir: store.dir().display().to_string(),
+                kept: store.kept(),
+                next: store.kept() + 1,
+            });
+        }
+        if now >= end {
+            break;
+        }
+        clock.wait_until((now + TICK_US).min(end));
+    }
+    rec.flush()?;
+    let said = check_rest(
+        rec.recording(),
+        &store.meta,
+        (from + WARMUP_US, end),
+        plan.force_rest_mismatch,
+    )?;
+    out.say(&said);
+    Ok(())
 }
 
 /// The EMG of the log a resumed calibration continues (empty when the log holds none).

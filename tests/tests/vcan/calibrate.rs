@@ -82,7 +82,9 @@ pub(super) fn calibrate_deploy_arm(env: &VcanEnv) -> PathBuf {
         t_sine,
         "the sine patient's amplifier never started",
     );
-    handctl(env, &["arm", "--socket", &sock]);
+    // The sine patient moves from its first sample, never at rest: the rest check before
+    // arm (driver/tests/rest_check.rs) is overridden here, as a technician would, audited.
+    handctl(env, &["arm", "--force-rest-mismatch", "--socket", &sock]);
     sine.wait_success(Duration::from_secs(90));
     let seen: Vec<Seen> = monitor
         .snapshot()

@@ -889,7 +889,12 @@ fn arm_at(rig: &Rig, at_us: u64) -> u64 {
     }
     let sent = now_us();
     let sock = rig.cfg.socket.display().to_string();
-    handctl(&rig.env, &["arm", "--socket", &sock]);
+    // The sine patient moves from its first sample, never at rest: the rest check before
+    // arm (driver/tests/rest_check.rs) is overridden here, as a technician would, audited.
+    handctl(
+        &rig.env,
+        &["arm", "--force-rest-mismatch", "--socket", &sock],
+    );
     sent
 }
 
