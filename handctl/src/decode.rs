@@ -58,6 +58,7 @@ pub fn run(a: &DecodeArgs) -> Result<(), CliError> {
             decoded.time_s.first().copied().unwrap_or(0.0),
             decoded.time_s.last().copied().unwrap_or(0.0)
         );
+        println!("{}", envelope_line(&model, &decoded));
     }
     let Some((name, reference)) = &decoded.reference else {
         return Ok(());
@@ -76,6 +77,34 @@ pub fn run(a: &DecodeArgs) -> Result<(), CliError> {
         print!("{}", table(name, &rows));
     }
     Ok(())
+}
+
+/// Beyond the calibration: how many windows the envelope moved back or found implausible,
+/// and the outputs' range.
+fn envelope_line(model: &TrainedModel, d: &Decoded) -> String {
+    let (lo, hi) = d
+        .outputs
+        .iter()
+        .flatten()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(*v), hi.max(*v))
+        });
+    let range = if lo <= hi {
+        format!("outputs from {lo:.3} to {hi:.3}")
+    } else {
+        "no outputs".into()
+    };
+    match model.envelope() {
+        Some(_) => format!(
+            "beyond the calibration: {} windows moved back into its envelope, {} implausible \
+             (one channel beyond, the others not: output rest); {range}",
+            d.beyond, d.implausible
+        ),
+        None => format!(
+            "this model file has no calibration envelope (older than format 2's envelope): \
+             inputs beyond its calibration reach the model unbounded; {range}"
+        ),
+    }
 }
 
 /// The agreement per finger as text for a technician.
@@ -129,6 +158,8 @@ fn json(name: &str, rows: &[(usize, Agreement)], decoded: &Decoded) -> serde_jso
     serde_json::json!({
         "reference": name,
         "windows": decoded.time_s.len(),
+        "beyond_calibration": decoded.beyond,
+        "implausible": decoded.implausible,
         "fingers": fingers,
     })
 }

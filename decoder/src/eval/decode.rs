@@ -20,6 +20,10 @@ pub struct Decoded {
     pub outputs: Vec<[f64; N_FINGERS]>,
     /// The reference's name and its mean over each window, if the session has one.
     pub reference: Option<(String, Vec<f64>)>,
+    /// Windows beyond the calibration's envelope, moved back into it (issue 25).
+    pub beyond: usize,
+    /// Windows with one channel beyond the calibration while the others are not: output rest.
+    pub implausible: usize,
 }
 
 impl Decoded {
@@ -89,8 +93,22 @@ pub fn decode(
             chain_differences(model.chain(), chain).join(", ")
         )));
     }
-    let outputs = model.predict_rows(&windows.features);
+    let n = model.normalizer().len();
+    let mut p = model.predictor();
+    let (mut beyond, mut implausible) = (0, 0);
+    let outputs: Vec<[f64; N_FINGERS]> = windows
+        .features
+        .chunks_exact(n)
+        .map(|row| {
+            let y = p.run(row);
+            beyond += usize::from(p.last_scale() < 1.0 && !p.last_implausible());
+            implausible += usize::from(p.last_implausible());
+            y
+        })
+        .collect();
     Ok(Decoded {
+        beyond,
+        implausible,
         time_s: windows.time_us.iter().map(|&t| t as f64 / 1e6).collect(),
         outputs,
         reference: reference.map(|r| {
