@@ -47,6 +47,10 @@ pub enum Request {
         /// Deploy a model whose file records no verification, or a failed (or forced) one.
         #[serde(default, skip_serializing_if = "std::ops::Not::not")]
         force: bool,
+        /// The technician confirmed replacing the running model with one for another (or an
+        /// unknown) patient; without it such a deploy is refused.
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        confirmed: bool,
     },
     /// Swap back the model the last deploy replaced.
     Rollback,
@@ -146,6 +150,14 @@ pub struct ModelStatus {
     pub verification: String,
     /// True when the file records no verification, or one that reverses (forced or not).
     pub unverified: bool,
+    /// The patient its file records; None for an unknown patient (a file without provenance,
+    /// a model trained without `--patient`, or a daemon older than this field).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub patient: Option<String>,
+    /// Its provenance, one line: "patient P-017, session S, calibrated 2026-12-02T13:15:28Z"
+    /// (and any quality gates bypassed), or "unknown patient (...)"; empty from an older daemon.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub provenance: String,
 }
 
 /// The daemon's answer.
@@ -245,7 +257,7 @@ impl Request {
             | Request::Stop
             | Request::Calibrating
             | Request::Rollback => &[],
-            Request::Deploy { .. } => &["path", "force"],
+            Request::Deploy { .. } => &["path", "force", "confirmed"],
             Request::Tune { .. } => &["finger", "kf", "kalpha"],
             Request::Subscribe { .. } => &["every_ms"],
         }
@@ -276,10 +288,12 @@ mod tests {
             Request::Deploy {
                 path: "/m.hsm".into(),
                 force: false,
+                confirmed: false,
             },
             Request::Deploy {
                 path: "/m.hsm".into(),
                 force: true,
+                confirmed: true,
             },
         ] {
             let line = serde_json::to_string(&r).unwrap();
@@ -355,7 +369,8 @@ mod tests {
             parse_request(r#"{"cmd":"deploy","path":"/abs/model.hsm"}"#).unwrap(),
             Request::Deploy {
                 path: "/abs/model.hsm".into(),
-                force: false
+                force: false,
+                confirmed: false,
             }
         );
         assert_eq!(
@@ -364,6 +379,10 @@ mod tests {
         );
         for (line, want) in [
             (r#"{"cmd":"deploy","path":7}"#, "field `path`"),
+            (
+                r#"{"cmd":"deploy","path":"/m","confirmed":1}"#,
+                "field `confirmed`",
+            ),
             (
                 r#"{"cmd":"deploy","path":"/m","force":"yes"}"#,
                 "field `force`",

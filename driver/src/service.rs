@@ -171,7 +171,11 @@ impl ControlHandler {
             },
             Request::Tune { finger, kf, kalpha } => self.tune(&finger, kf, kalpha, &user),
             Request::Calibrating => self.calibrating(peer, &user),
-            Request::Deploy { path, force } => self.deploy(&path, force, peer, &user),
+            Request::Deploy {
+                path,
+                force,
+                confirmed,
+            } => self.deploy(&path, force, confirmed, peer, &user),
             Request::Rollback => self.rollback(peer, &user),
             Request::Arm => self.arm(peer, &user),
             Request::Subscribe { .. } => Reply::Refused {
