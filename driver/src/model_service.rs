@@ -81,6 +81,22 @@ impl ControlHandler {
         }
     }
 
+    /// `deploy` with `check_only`: the checks of [`prepare`], nothing installed, swapped or
+    /// audited; the answer names the model. The patient is not checked here: `handctl deploy`
+    /// shows both and asks, then sends the deploy itself, which checks it.
+    pub(crate) fn check_deploy(&self, path: &str, force: bool) -> Reply {
+        match prepare(path, &self.chain, &self.config.deploy, force) {
+            Ok(p) => Reply::Ok {
+                message: format!(
+                    "checked: model {} (id {:08x}) passes handd's checks; nothing changed",
+                    path, p.loaded.model_id
+                ),
+                status: None,
+            },
+            Err(e) => refused(e),
+        }
+    }
+
     /// `deploy`: checked (a model for another or an unknown patient than the running one's
     /// only when `confirmed`), audited, installed, swapped in; refused with nothing changed
     /// otherwise (an audit line that cannot be written included).
@@ -337,6 +353,7 @@ mod tests {
                 path: model.display().to_string(),
                 force: true,
                 confirmed: true,
+                check_only: false,
             },
             ROOT,
         );
@@ -491,6 +508,7 @@ mod tests {
                 path: model.display().to_string(),
                 force: true,
                 confirmed: true,
+                check_only: false,
             },
             ROOT,
         );
@@ -595,6 +613,7 @@ mod tests {
                 path: path.display().to_string(),
                 force: true,
                 confirmed,
+                check_only: false,
             },
             ROOT,
         )
@@ -640,6 +659,22 @@ mod tests {
                 format!("{id_a:08x}")
             );
         }
+        // Only a check: passes (the patient is handctl's question), nothing changes.
+        let m = message(&handler.handle(
+            Request::Deploy {
+                path: other.display().to_string(),
+                force: true,
+                confirmed: false,
+                check_only: true,
+            },
+            ROOT,
+        ));
+        assert!(
+            m.starts_with("checked: ") && m.ends_with("nothing changed"),
+            "{m}"
+        );
+        assert_eq!(looper.swaps.load(Ordering::SeqCst), 0, "nothing swapped");
+        assert!(!config.control.audit_log.exists(), "nothing audited");
         // The same patient needs no confirmation.
         let same = dir.join("same.hsm");
         with_patient(trained(4), "P-001")

@@ -51,6 +51,11 @@ pub enum Request {
         /// unknown) patient; without it such a deploy is refused.
         #[serde(default, skip_serializing_if = "std::ops::Not::not")]
         confirmed: bool,
+        /// Only check: every check but the patient's, then answer without installing or
+        /// swapping anything (`handctl deploy` asks this first, so a model handd would refuse
+        /// anyway is refused before the technician is asked about the patient).
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        check_only: bool,
     },
     /// Swap back the model the last deploy replaced.
     Rollback,
@@ -257,7 +262,7 @@ impl Request {
             | Request::Stop
             | Request::Calibrating
             | Request::Rollback => &[],
-            Request::Deploy { .. } => &["path", "force", "confirmed"],
+            Request::Deploy { .. } => &["path", "force", "confirmed", "check_only"],
             Request::Tune { .. } => &["finger", "kf", "kalpha"],
             Request::Subscribe { .. } => &["every_ms"],
         }
@@ -289,11 +294,13 @@ mod tests {
                 path: "/m.hsm".into(),
                 force: false,
                 confirmed: false,
+                check_only: false,
             },
             Request::Deploy {
                 path: "/m.hsm".into(),
                 force: true,
                 confirmed: true,
+                check_only: true,
             },
         ] {
             let line = serde_json::to_string(&r).unwrap();
@@ -371,6 +378,7 @@ mod tests {
                 path: "/abs/model.hsm".into(),
                 force: false,
                 confirmed: false,
+                check_only: false,
             }
         );
         assert_eq!(

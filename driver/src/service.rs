@@ -174,7 +174,14 @@ impl ControlHandler {
             Request::Deploy {
                 path,
                 force,
+                check_only: true,
+                ..
+            } => self.check_deploy(&path, force),
+            Request::Deploy {
+                path,
+                force,
                 confirmed,
+                check_only: false,
             } => self.deploy(&path, force, confirmed, peer, &user),
             Request::Rollback => self.rollback(peer, &user),
             Request::Arm => self.arm(peer, &user),
