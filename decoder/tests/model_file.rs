@@ -440,3 +440,72 @@ fn required_sections_are_listed_and_an_unknown_one_is_refused() {
     let old = load(&join_version(&p, 1)).expect("a version 1 file loads");
     assert_eq!(old.rest_stage(), with_stage.rest_stage());
 }
+
+/// Issue 32 item 4: the file records which patient and session, when, and the quality gates
+/// bypassed; the section is descriptive (not required), and a file without it (older, or a
+/// version 1 file) loads as "unknown patient". A bad record is refused, named.
+#[test]
+fn provenance_round_trips_and_older_files_load_as_unknown_patient() {
+    use decoder::model::provenance::describe_provenance;
+    use decoder::model::Provenance;
+    let record = Provenance {
+        patient: Some("P-017".into()),
+        session: "fitting-2026-12-02".into(),
+        calibrated_utc: "2026-12-02T13:15:28Z".into(),
+        ignore_gates: true,
+        gates_bypassed: vec!["trial 3 (index flexion, repetition 1): channel 4 is flat".into()],
+    };
+    let plain = trained(ModelKind::ResDd);
+    let with = plain.clone().with_provenance(record.clone()).unwrap();
+    let bytes = with.to_bytes().unwrap();
+    let back = TrainedModel::from_bytes(&bytes, Some(&chain(2))).unwrap();
+    assert_eq!(back, with);
+    assert_eq!(back.provenance(), Some(&record));
+    let line = describe_provenance(back.provenance());
+    assert!(
+        line.starts_with(
+            "patient P-017, session fitting-2026-12-02, calibrated 2026-12-02T13:15:28Z; \
+             QUALITY GATES BYPASSED (--ignore-gates): 1 finding(s): trial 3"
+        ),
+        "{line}"
+    );
+    let mut p = split(&bytes);
+    assert_eq!(p.meta["provenance"]["patient"], "P-017");
+    let required = p.meta["required"].as_array().unwrap();
+    assert!(
+        required.iter().all(|r| r != "provenance"),
+        "descriptive, not required: {required:?}"
+    );
+    // The checksum covers it.
+    let at = bytes.windows(5).position(|w| w == b"P-017").unwrap();
+    let mut v = bytes.clone();
+    v[at + 4] = b'8';
+    assert!(matches!(
+        TrainedModel::from_bytes(&v, None),
+        Err(FileError::BadChecksum { .. })
+    ));
+    // A bad record with a right checksum is malformed, named.
+    p.meta["provenance"]["patient"] = serde_json::json!("P 017; rm");
+    let e = TrainedModel::from_bytes(&join(&p), None).unwrap_err();
+    assert!(
+        matches!(&e, FileError::Malformed(m) if m.contains("provenance") && m.contains("patient id")),
+        "{e}"
+    );
+    // The older file: no `provenance` key, in version 2 and in version 1.
+    p.meta.as_object_mut().unwrap().remove("provenance");
+    let old = TrainedModel::from_bytes(&join(&p), Some(&chain(2))).unwrap();
+    assert_eq!(old, plain);
+    assert_eq!(old.provenance(), None);
+    assert!(describe_provenance(old.provenance()).starts_with("unknown patient"));
+    p.meta.as_object_mut().unwrap().remove("required");
+    let v1 = TrainedModel::from_bytes(&join_version(&p, 1), Some(&chain(2))).unwrap();
+    assert_eq!(v1.provenance(), None);
+    // A program cannot put a malformed record into a model either.
+    let e = plain
+        .with_provenance(Provenance {
+            calibrated_utc: "yesterday".into(),
+            ..record
+        })
+        .unwrap_err();
+    assert!(e.to_string().contains("calibration date"), "{e}");
+}

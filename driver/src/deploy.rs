@@ -3,8 +3,12 @@
 //! loop runs, and its recorded verification is checked; then it is installed (copied beside
 //! the config's model path as `model-<id>.hsm`, and the config rewritten atomically to name
 //! it, so a restart runs the deployed model) and handed to the loop, which swaps it in at a
-//! tick boundary ([`crate::engine::ModelSwap`]). Every refusal names the reason; nothing
-//! changes on one.
+//! tick boundary ([`crate::engine::ModelSwap`]). A model for another patient than the running
+//! model's (or for an unknown one) is refused unless the request says the technician confirmed
+//! it ([`patient_change`]). The audit line is written before anything changes: a deploy or a
+//! rollback whose line cannot be written is refused ([`try_audit`]). A rollback re-reads the
+//! file it points the config back at and refuses if its fingerprint is no longer the running
+//! copy's ([`check_fingerprint`]). Every refusal names the reason; nothing changes on one.
 
 use std::fs::OpenOptions;
 use std::io::Write;
@@ -14,7 +18,8 @@ use decoder::dsp::ChainConfig;
 
 use crate::config::{Config, DeployConfig};
 use crate::control::Peer;
-use crate::startup::{check_model, LoadedModel, StartupError};
+use crate::protocol::ModelStatus;
+use crate::startup::{check_model, fingerprint, LoadedModel, StartupError};
 
 /// Why a deploy or a rollback was refused.
 #[derive(Debug, thiserror::Error)]
@@ -47,6 +52,31 @@ pub enum DeployError {
         /// The model file.
         path: PathBuf,
         /// What falls short, with the config's figure.
+        why: String,
+    },
+    /// The model is for another (or an unknown) patient than the running one, and the request
+    /// does not say the technician confirmed it.
+    #[error("model {path}: {change}; refused without the technician's confirmation (`handctl deploy` shows both and asks; --yes for scripts)")]
+    PatientDiffers {
+        /// The model file.
+        path: PathBuf,
+        /// Both patients, in words ([`patient_change`]).
+        change: String,
+    },
+    /// The file a rollback would point the config back at is not the model kept in memory.
+    #[error("the model to roll back to, {path}, {why}: refused; nothing changed (the running model and the config stay)")]
+    Replaced {
+        /// The file the config would name.
+        path: PathBuf,
+        /// What is wrong with it: unreadable, or another fingerprint.
+        why: String,
+    },
+    /// The audit line could not be written.
+    #[error("the audit log {path} could not be written ({why}): refused; nothing changed")]
+    Audit {
+        /// The audit log.
+        path: PathBuf,
+        /// What the OS said.
         why: String,
     },
     /// The model file or the config could not be written.
@@ -114,6 +144,48 @@ pub fn prepare(
         bytes,
         source,
     })
+}
+
+/// Whether swapping in a model for `model_patient` over `running` needs the technician's
+/// confirmation, and if so both patients in words: "this model is for patient B, the running
+/// model (id 0badf00d) for patient A". It does unless no model runs or both files name the same
+/// patient: an unknown patient (a file without provenance, or trained without `--patient`) on
+/// either side is never taken for the same one.
+pub fn patient_change(
+    model_patient: Option<&str>,
+    running: Option<&ModelStatus>,
+) -> Option<String> {
+    let running = running?;
+    let (new, old) = (model_patient, running.patient.as_deref());
+    if new.is_some() && new == old {
+        return None;
+    }
+    let words = decoder::model::provenance::patient_words;
+    Some(format!(
+        "this model is for {}, the running model (id {}) for {}",
+        words(new),
+        running.id,
+        words(old)
+    ))
+}
+
+/// Checks that the file at `path` is still the model with fingerprint `id` (8 hex digits, as
+/// [`ModelStatus::id`]): a rollback points the config back at it, so a restart must run the
+/// model that runs now.
+pub fn check_fingerprint(path: &Path, id: &str) -> Result<(), DeployError> {
+    let replaced = |why: String| DeployError::Replaced {
+        path: path.to_owned(),
+        why,
+    };
+    let bytes = std::fs::read(path).map_err(|e| replaced(format!("cannot be read: {e}")))?;
+    let found = format!("{:08x}", fingerprint(&bytes));
+    if found == id {
+        Ok(())
+    } else {
+        Err(replaced(format!(
+            "changed on disk: its fingerprint is {found}, the model kept in memory is {id}"
+        )))
+    }
 }
 
 /// What a passed verification lacks against `policy`, if anything.
@@ -203,9 +275,10 @@ pub fn audit_times() -> String {
     format!("time={time_s:.3} mono={mono_s:.3}")
 }
 
-/// Appends one line to the audit log: times ([`audit_times`]), who (user, uid, pid), what
-/// (`action` with its details). A failure is logged, never fatal.
-pub fn audit(log: &Path, user: &str, peer: Peer, action: &str) {
+/// Appends one line to the audit log and syncs it: times ([`audit_times`]), who (user, uid,
+/// pid), what (`action` with its details). Deploy and rollback write theirs with this before
+/// anything changes, and are refused when it fails.
+pub fn try_audit(log: &Path, user: &str, peer: Peer, action: &str) -> Result<(), DeployError> {
     let line = format!(
         "{} user={user} uid={} pid={} {action}",
         audit_times(),
@@ -220,8 +293,17 @@ pub fn audit(log: &Path, user: &str, peer: Peer, action: &str) {
         writeln!(f, "{line}")?;
         f.sync_data()
     };
-    if let Err(e) = write() {
-        tracing::warn!(error = %e, path = %log.display(), "audit log not written");
+    write().map_err(|e| DeployError::Audit {
+        path: log.to_owned(),
+        why: e.to_string(),
+    })
+}
+
+/// [`try_audit`] for the actions that go on without their line (`stop`, `arm`, `tune`,
+/// `calibrating`: refusing a stop would be worse): a failure is logged, never fatal.
+pub fn audit(log: &Path, user: &str, peer: Peer, action: &str) {
+    if let Err(e) = try_audit(log, user, peer, action) {
+        tracing::warn!(error = %e, "audit log not written");
     }
 }
 

@@ -7,7 +7,10 @@ use std::sync::mpsc::sync_channel;
 use std::time::Duration;
 
 use crate::control::Peer;
-use crate::deploy::{audit, install, point_config, prepare, DeployError};
+use crate::deploy::{
+    audit, check_fingerprint, install, installed_path, patient_change, point_config, prepare,
+    try_audit, DeployError,
+};
 use crate::engine::{Command, Hold, ModelSwap};
 use crate::protocol::{ModelStatus, Reply};
 use crate::service::ControlHandler;
@@ -78,15 +81,65 @@ impl ControlHandler {
         }
     }
 
-    /// `deploy`: checked, installed, swapped in; refused with nothing changed otherwise.
-    pub(crate) fn deploy(&mut self, path: &str, force: bool, peer: Peer, user: &str) -> Reply {
+    /// `deploy` with `check_only`: the checks of [`prepare`], nothing installed, swapped or
+    /// audited; the answer names the model. The patient is not checked here: `handctl deploy`
+    /// shows both and asks, then sends the deploy itself, which checks it.
+    pub(crate) fn check_deploy(&self, path: &str, force: bool) -> Reply {
+        match prepare(path, &self.chain, &self.config.deploy, force) {
+            Ok(p) => Reply::Ok {
+                message: format!(
+                    "checked: model {} (id {:08x}) passes handd's checks; nothing changed",
+                    path, p.loaded.model_id
+                ),
+                status: None,
+            },
+            Err(e) => refused(e),
+        }
+    }
+
+    /// `deploy`: checked (a model for another or an unknown patient than the running one's
+    /// only when `confirmed`), audited, installed, swapped in; refused with nothing changed
+    /// otherwise (an audit line that cannot be written included).
+    pub(crate) fn deploy(
+        &mut self,
+        path: &str,
+        force: bool,
+        confirmed: bool,
+        peer: Peer,
+        user: &str,
+    ) -> Reply {
         let prepared = match prepare(path, &self.chain, &self.config.deploy, force) {
             Ok(p) => p,
             Err(e) => return refused(e),
         };
+        let patient = prepared
+            .loaded
+            .model
+            .provenance()
+            .and_then(|p| p.patient.clone());
+        if let (Some(change), false) = (
+            patient_change(patient.as_deref(), self.model.as_ref()),
+            confirmed,
+        ) {
+            return refused(DeployError::PatientDiffers {
+                path: prepared.source,
+                change,
+            });
+        }
+        let id = format!("{:08x}", prepared.loaded.model_id);
+        let what = format!(
+            "deploy path={path} installed={} id={id} previous={} force={force} patient={} \
+             confirmed={confirmed}",
+            installed_path(&self.config.model, prepared.loaded.model_id).display(),
+            self.running_id(),
+            patient.as_deref().unwrap_or("?"),
+        );
+        if let Err(e) = try_audit(&self.config.control.audit_log, user, peer, &what) {
+            return refused(e);
+        }
         let (next, target) = match install(&prepared, &self.config, &self.config_path) {
             Ok(x) => x,
-            Err(e) => return refused(e),
+            Err(e) => return self.failed("deploy", &id, e, peer, user),
         };
         let status = prepared.loaded.status(&target);
         let (tx, rx) = sync_channel(1);
@@ -99,34 +152,46 @@ impl ControlHandler {
             Ok(old) => old,
             Err(e) => {
                 self.restore_config();
-                return refused(e);
+                return self.failed("deploy", &id, e, peer, user);
             }
         };
         self.config = next;
         let replaced = self.model.replace(status.clone());
-        let previous = replaced.as_ref().map_or("none".into(), |s| s.id.clone());
         self.previous = match (old.predictor.is_some(), replaced) {
             (true, Some(s)) => Some((old, s)),
             _ => None,
         };
-        self.after_swap("deploy", &status, &previous, path, peer, user, force)
+        self.after_swap("deploy", &status, peer, user)
     }
 
     /// `rollback`: the model the last deploy or rollback replaced comes back (so a second
-    /// rollback undoes the first).
+    /// rollback undoes the first), once its file is checked to still be that model and the
+    /// audit line is written; refused with nothing changed otherwise.
     pub(crate) fn rollback(&mut self, peer: Peer, user: &str) -> Reply {
         let Some((mut back, status)) = self.previous.take() else {
             return refused(DeployError::NoPrevious);
         };
-        let next = match point_config(
-            &self.config,
-            std::path::Path::new(&status.path),
-            &self.config_path,
-        ) {
+        let file = std::path::PathBuf::from(&status.path);
+        let what = format!(
+            "rollback path={} installed={} id={} previous={} force=false patient={}",
+            status.path,
+            status.path,
+            status.id,
+            self.running_id(),
+            status.patient.as_deref().unwrap_or("?"),
+        );
+        let checked = check_fingerprint(&file, &status.id)
+            .and_then(|()| try_audit(&self.config.control.audit_log, user, peer, &what));
+        if let Err(e) = checked {
+            self.previous = Some((back, status));
+            return refused(e);
+        }
+        let next = match point_config(&self.config, &file, &self.config_path) {
             Ok(n) => n,
             Err(e) => {
+                let id = status.id.clone();
                 self.previous = Some((back, status));
-                return refused(e);
+                return self.failed("rollback", &id, e, peer, user);
             }
         };
         let (tx, rx) = sync_channel(1);
@@ -138,15 +203,26 @@ impl ControlHandler {
             Err(e) => {
                 // The box is lost with a loop that is gone; the config goes back.
                 self.restore_config();
-                return refused(e);
+                return self.failed("rollback", &status.id, e, peer, user);
             }
         };
         self.config = next;
         let replaced = self.model.replace(status.clone());
-        let previous = replaced.as_ref().map_or("none".into(), |s| s.id.clone());
         self.previous = replaced.map(|s| (old, s));
-        let path = status.path.clone();
-        self.after_swap("rollback", &status, &previous, &path, peer, user, false)
+        self.after_swap("rollback", &status, peer, user)
+    }
+
+    /// The running model's id for the audit line, "none" when none runs.
+    fn running_id(&self) -> String {
+        self.model.as_ref().map_or("none".into(), |s| s.id.clone())
+    }
+
+    /// A deploy or rollback that failed after its audit line: a second line says so (best
+    /// effort: the first one is on disk), and the refusal.
+    fn failed(&self, action: &str, id: &str, e: DeployError, peer: Peer, user: &str) -> Reply {
+        let what = format!("{action}-failed id={id} reason={:?}", e.to_string());
+        audit(&self.config.control.audit_log, user, peer, &what);
+        refused(e)
     }
 
     /// The running model's calibration rest levels, read from its file here on the control
@@ -175,38 +251,29 @@ impl ControlHandler {
         }
     }
 
-    /// Audit, log, release the calibrating hold's first condition, and the reply; `previous` is
-    /// the id of the model replaced ("none" when there was none).
-    #[allow(clippy::too_many_arguments, reason = "one audit line's fields")]
-    fn after_swap(
-        &mut self,
-        action: &str,
-        status: &ModelStatus,
-        previous: &str,
-        source: &str,
-        peer: Peer,
-        user: &str,
-        force: bool,
-    ) -> Reply {
+    /// Log, release the calibrating hold's first condition, and the reply (the audit line is
+    /// written before the swap).
+    fn after_swap(&mut self, action: &str, status: &ModelStatus, peer: Peer, user: &str) -> Reply {
         self.no_model = false;
         self.tell_live(status);
         if self.hold == Hold::Calibrating {
             self.hold = Hold::Deployed;
         }
-        let what = format!(
-            "{action} path={source} installed={} id={} previous={previous} force={force}",
-            status.path, status.id
-        );
-        audit(&self.config.control.audit_log, user, peer, &what);
         tracing::warn!(user, uid = peer.uid, pid = peer.pid, model = %status.path, id = %status.id, "{action}");
         let arm = if self.hold == Hold::Deployed {
             "; the hand stays held until `handctl arm`"
         } else {
             ""
         };
+        let origin = if status.provenance.is_empty() {
+            String::new()
+        } else {
+            format!("; {}", status.provenance)
+        };
         Reply::Ok {
             message: format!(
-                "{action}: model {} (id {}) runs from this tick on; the config names it{arm}",
+                "{action}: model {} (id {}{origin}) runs from this tick on; the config names \
+                 it{arm}",
                 status.path, status.id
             ),
             status: Some(self.status()),
@@ -286,6 +353,8 @@ mod tests {
             Request::Deploy {
                 path: model.display().to_string(),
                 force: true,
+                confirmed: true,
+                check_only: false,
             },
             ROOT,
         );
@@ -349,6 +418,7 @@ mod tests {
                 kind: "resdd".into(),
                 verification: "verified".into(),
                 unverified: false,
+                ..Default::default()
             })
             .with_latches(store, crate::engine::Hold::Free);
         let m = message(&handler.handle(Request::Stop, ROOT));
@@ -412,6 +482,12 @@ mod tests {
         let (dir, config, config_path) = setup("previous");
         let model = dir.join("new.hsm");
         trained(6).save(&model).expect("model saved");
+        // The running model's file, there for the rollback to find it unchanged.
+        trained(4).save(&config.model).expect("model saved");
+        let running_id = format!(
+            "{:08x}",
+            crate::startup::fingerprint(&std::fs::read(&config.model).expect("read"))
+        );
         let (tx, rx) = sync_channel::<Command>(COMMAND_QUEUE);
         // A stand-in loop that swaps every model it is given.
         let looper = std::thread::spawn(move || {
@@ -427,15 +503,18 @@ mod tests {
         let mut handler = ControlHandler::new(config.clone(), config_path, Default::default(), tx)
             .with_model(crate::protocol::ModelStatus {
                 path: config.model.display().to_string(),
-                id: "0000abcd".into(),
+                id: running_id.clone(),
                 kind: "resdd".into(),
                 verification: "verified".into(),
                 unverified: false,
+                ..Default::default()
             });
         let reply = handler.handle(
             Request::Deploy {
                 path: model.display().to_string(),
                 force: true,
+                confirmed: true,
+                check_only: false,
             },
             ROOT,
         );
@@ -447,18 +526,290 @@ mod tests {
         assert_eq!(lines.len(), 2, "{lines:?}");
         assert!(
             lines[0].contains(&format!(" deploy path={}", model.display()))
-                && lines[0].contains(&format!(" id={new_id} previous=0000abcd ")),
+                && lines[0].contains(&format!(" id={new_id} previous={running_id} ")),
             "{}",
             lines[0]
         );
         assert!(
             lines[1].contains(" rollback ")
-                && lines[1].contains(&format!(" id=0000abcd previous={new_id} ")),
+                && lines[1].contains(&format!(" id={running_id} previous={new_id} ")),
             "{}",
             lines[1]
         );
         drop(handler);
         looper.join().expect("loop");
+        std::fs::remove_dir_all(&dir).expect("clean up");
+    }
+
+    /// A stand-in loop that swaps like the real one: it keeps the running model and sends the
+    /// one replaced back; `running` is the id it runs, `swaps` how many swaps it took.
+    struct SwapLoop {
+        running: std::sync::Arc<std::sync::Mutex<u32>>,
+        swaps: std::sync::Arc<std::sync::atomic::AtomicUsize>,
+        thread: std::thread::JoinHandle<()>,
+    }
+
+    fn swap_loop(
+        rx: std::sync::mpsc::Receiver<Command>,
+        first: &TrainedModel,
+        id: u32,
+    ) -> SwapLoop {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        use std::sync::{Arc, Mutex};
+        let running = Arc::new(Mutex::new(id));
+        let swaps = Arc::new(AtomicUsize::new(0));
+        let (r, n) = (Arc::clone(&running), Arc::clone(&swaps));
+        let mut current = (Some(first.predictor()), id);
+        let thread = std::thread::spawn(move || {
+            while let Ok(cmd) = rx.recv() {
+                if let Command::Swap(mut m) = cmd {
+                    assert!(m.ticket.take(), "a pending ticket");
+                    std::mem::swap(&mut m.predictor, &mut current.0);
+                    std::mem::swap(&mut m.model_id, &mut current.1);
+                    *r.lock().expect("lock") = current.1;
+                    n.fetch_add(1, Ordering::SeqCst);
+                    m.swapped = true;
+                    let back = m.back.take().expect("a way back");
+                    back.send(m).expect("the sender waits");
+                }
+            }
+        });
+        SwapLoop {
+            running,
+            swaps,
+            thread,
+        }
+    }
+
+    fn with_patient(model: TrainedModel, patient: &str) -> TrainedModel {
+        model
+            .with_provenance(decoder::model::Provenance {
+                patient: Some(patient.into()),
+                session: "fitting-1".into(),
+                calibrated_utc: "2026-12-02T13:15:28Z".into(),
+                ignore_gates: false,
+                gates_bypassed: Vec::new(),
+            })
+            .expect("provenance")
+    }
+
+    /// A handler over a [`swap_loop`] running the model saved at the config's model path.
+    fn running(
+        config: &Config,
+        config_path: &Path,
+        model: &TrainedModel,
+    ) -> (ControlHandler, SwapLoop) {
+        model.save(&config.model).expect("model saved");
+        let loaded = crate::startup::load_model(&config.model, config.mains_hz).expect("loads");
+        let (tx, rx) = sync_channel::<Command>(COMMAND_QUEUE);
+        let looper = swap_loop(rx, model, loaded.model_id);
+        let handler = ControlHandler::new(
+            config.clone(),
+            config_path.to_owned(),
+            Default::default(),
+            tx,
+        )
+        .with_model(loaded.status(&config.model));
+        (handler, looper)
+    }
+
+    fn deploy(h: &mut ControlHandler, path: &Path, confirmed: bool) -> Reply {
+        h.handle(
+            Request::Deploy {
+                path: path.display().to_string(),
+                force: true,
+                confirmed,
+                check_only: false,
+            },
+            ROOT,
+        )
+    }
+
+    fn id_of(path: &Path) -> u32 {
+        crate::startup::fingerprint(&std::fs::read(path).expect("model file"))
+    }
+
+    #[test]
+    fn a_model_for_another_patient_needs_the_confirmation() {
+        use std::sync::atomic::Ordering;
+        let (dir, config, config_path) = setup("patient");
+        let first = with_patient(trained(1), "P-001");
+        let (mut handler, looper) = running(&config, &config_path, &first);
+        let id_a = id_of(&config.model);
+        let other = dir.join("other.hsm");
+        with_patient(trained(2), "P-002")
+            .save(&other)
+            .expect("saved");
+        let unknown = dir.join("unknown.hsm");
+        trained(3).save(&unknown).expect("saved");
+        // Another patient, and an unknown one: refused, nothing changed.
+        for (file, words) in [(&other, "patient P-002"), (&unknown, "unknown patient")] {
+            let m = message(&deploy(&mut handler, file, false));
+            assert!(
+                m.starts_with("refused:")
+                    && m.contains(&format!(
+                        "this model is for {words}, the running model (id {id_a:08x}) for \
+                         patient P-001"
+                    ))
+                    && m.contains("confirmation"),
+                "{m}"
+            );
+            assert_eq!(looper.swaps.load(Ordering::SeqCst), 0, "nothing swapped");
+            assert_eq!(*looper.running.lock().unwrap(), id_a);
+            assert_eq!(
+                Config::load(&config_path).expect("config").model,
+                config.model
+            );
+            assert_eq!(
+                handler.status().model.expect("model").id,
+                format!("{id_a:08x}")
+            );
+        }
+        // Only a check: passes (the patient is handctl's question), nothing changes.
+        let m = message(&handler.handle(
+            Request::Deploy {
+                path: other.display().to_string(),
+                force: true,
+                confirmed: false,
+                check_only: true,
+            },
+            ROOT,
+        ));
+        assert!(
+            m.starts_with("checked: ") && m.ends_with("nothing changed"),
+            "{m}"
+        );
+        assert_eq!(looper.swaps.load(Ordering::SeqCst), 0, "nothing swapped");
+        assert!(!config.control.audit_log.exists(), "nothing audited");
+        // The same patient needs no confirmation.
+        let same = dir.join("same.hsm");
+        with_patient(trained(4), "P-001")
+            .save(&same)
+            .expect("saved");
+        let reply = deploy(&mut handler, &same, false);
+        assert!(matches!(reply, Reply::Ok { .. }), "{}", message(&reply));
+        assert_eq!(*looper.running.lock().unwrap(), id_of(&same));
+        // Another patient, confirmed: deployed, and the audit line says so.
+        let reply = deploy(&mut handler, &other, true);
+        assert!(matches!(reply, Reply::Ok { .. }), "{}", message(&reply));
+        let id_b = id_of(&other);
+        assert_eq!(*looper.running.lock().unwrap(), id_b);
+        let st = handler.status().model.expect("model");
+        assert_eq!(
+            (st.id, st.patient.as_deref()),
+            (format!("{id_b:08x}"), Some("P-002"))
+        );
+        let lines = audit_lines(&config.control.audit_log);
+        assert_eq!(lines.len(), 2, "{lines:?}");
+        assert!(
+            lines[1].contains(&format!(" id={id_b:08x} "))
+                && lines[1].ends_with(" patient=P-002 confirmed=true"),
+            "{}",
+            lines[1]
+        );
+        drop(handler);
+        looper.thread.join().expect("loop");
+        std::fs::remove_dir_all(&dir).expect("clean up");
+    }
+
+    #[test]
+    fn rollback_refuses_a_replaced_file_whose_bytes_changed() {
+        let (dir, config, config_path) = setup("replaced");
+        let first = trained(1);
+        let (mut handler, looper) = running(&config, &config_path, &first);
+        let id_a = id_of(&config.model);
+        let original = std::fs::read(&config.model).expect("model A");
+        let new = dir.join("new.hsm");
+        trained(2).save(&new).expect("saved");
+        let id_b = id_of(&new);
+        let reply = deploy(&mut handler, &new, true);
+        assert!(matches!(reply, Reply::Ok { .. }), "{}", message(&reply));
+        let installed = Config::load(&config_path).expect("config").model;
+        // Model A's file is overwritten with another model.
+        trained(9).save(&config.model).expect("saved");
+        let m = message(&handler.handle(Request::Rollback, ROOT));
+        assert!(
+            m.starts_with("refused:")
+                && m.contains(&format!("{}, changed on disk", config.model.display()))
+                && m.contains(&format!("the model kept in memory is {id_a:08x}")),
+            "{m}"
+        );
+        assert_eq!(*looper.running.lock().unwrap(), id_b, "B still runs");
+        assert_eq!(Config::load(&config_path).expect("config").model, installed);
+        assert_eq!(
+            handler.status().model.expect("model").id,
+            format!("{id_b:08x}")
+        );
+        assert_eq!(
+            audit_lines(&config.control.audit_log).len(),
+            1,
+            "no rollback line"
+        );
+        // A's bytes back: the rollback kept for later goes through.
+        std::fs::write(&config.model, &original).expect("restored");
+        let reply = handler.handle(Request::Rollback, ROOT);
+        assert!(matches!(reply, Reply::Ok { .. }), "{}", message(&reply));
+        assert_eq!(*looper.running.lock().unwrap(), id_a);
+        assert_eq!(
+            Config::load(&config_path).expect("config").model,
+            config.model
+        );
+        drop(handler);
+        looper.thread.join().expect("loop");
+        std::fs::remove_dir_all(&dir).expect("clean up");
+    }
+
+    #[test]
+    fn an_unwritable_audit_log_refuses_deploy_and_rollback_with_nothing_changed() {
+        use std::sync::atomic::Ordering;
+        let (dir, config, config_path) = setup("audit");
+        let first = trained(1);
+        let (mut handler, looper) = running(&config, &config_path, &first);
+        let id_a = id_of(&config.model);
+        let new = dir.join("new.hsm");
+        trained(2).save(&new).expect("saved");
+        let id_b = id_of(&new);
+        // The audit log's place is taken by a directory: no line can be appended.
+        std::fs::create_dir_all(&config.control.audit_log).expect("directory");
+        let config_before = std::fs::read(&config_path).expect("config");
+        let m = message(&deploy(&mut handler, &new, true));
+        assert!(
+            m.starts_with("refused: the audit log")
+                && m.contains("could not be written")
+                && m.ends_with("nothing changed"),
+            "{m}"
+        );
+        assert_eq!(looper.swaps.load(Ordering::SeqCst), 0, "nothing swapped");
+        assert_eq!(*looper.running.lock().unwrap(), id_a);
+        assert_eq!(std::fs::read(&config_path).expect("config"), config_before);
+        assert_eq!(
+            handler.status().model.expect("model").id,
+            format!("{id_a:08x}")
+        );
+        assert!(!crate::deploy::installed_path(&config.model, id_b).exists());
+        // With the log writable the deploy goes through; then a rollback without it is
+        // refused the same way.
+        std::fs::remove_dir(&config.control.audit_log).expect("removed");
+        let reply = deploy(&mut handler, &new, true);
+        assert!(matches!(reply, Reply::Ok { .. }), "{}", message(&reply));
+        std::fs::remove_file(&config.control.audit_log).expect("removed");
+        std::fs::create_dir_all(&config.control.audit_log).expect("directory");
+        let config_before = std::fs::read(&config_path).expect("config");
+        let m = message(&handler.handle(Request::Rollback, ROOT));
+        assert!(m.starts_with("refused: the audit log"), "{m}");
+        assert_eq!(
+            looper.swaps.load(Ordering::SeqCst),
+            1,
+            "only the deploy swapped"
+        );
+        assert_eq!(*looper.running.lock().unwrap(), id_b);
+        assert_eq!(std::fs::read(&config_path).expect("config"), config_before);
+        assert_eq!(
+            handler.status().model.expect("model").id,
+            format!("{id_b:08x}")
+        );
+        drop(handler);
+        looper.thread.join().expect("loop");
         std::fs::remove_dir_all(&dir).expect("clean up");
     }
 }

@@ -52,6 +52,15 @@ pub enum Request {
         /// Deploy a model whose file records no verification, or a failed (or forced) one.
         #[serde(default, skip_serializing_if = "std::ops::Not::not")]
         force: bool,
+        /// The technician confirmed replacing the running model with one for another (or an
+        /// unknown) patient; without it such a deploy is refused.
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        confirmed: bool,
+        /// Only check: every check but the patient's, then answer without installing or
+        /// swapping anything (`handctl deploy` asks this first, so a model handd would refuse
+        /// anyway is refused before the technician is asked about the patient).
+        #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+        check_only: bool,
     },
     /// Swap back the model the last deploy replaced.
     Rollback,
@@ -155,6 +164,14 @@ pub struct ModelStatus {
     pub verification: String,
     /// True when the file records no verification, or one that reverses (forced or not).
     pub unverified: bool,
+    /// The patient its file records; None for an unknown patient (a file without provenance,
+    /// a model trained without `--patient`, or a daemon older than this field).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub patient: Option<String>,
+    /// Its provenance, one line: "patient P-017, session S, calibrated 2026-12-02T13:15:28Z"
+    /// (and any quality gates bypassed), or "unknown patient (...)"; empty from an older daemon.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub provenance: String,
 }
 
 /// The daemon's answer.
@@ -250,7 +267,7 @@ impl Request {
     fn fields(&self) -> &'static [&'static str] {
         match self {
             Request::Status | Request::Stop | Request::Calibrating | Request::Rollback => &[],
-            Request::Deploy { .. } => &["path", "force"],
+            Request::Deploy { .. } => &["path", "force", "confirmed", "check_only"],
             Request::Arm { .. } => &["force_rest_mismatch"],
             Request::Tune { .. } => &["finger", "kf", "kalpha"],
             Request::Subscribe { .. } => &["every_ms"],
@@ -287,10 +304,14 @@ mod tests {
             Request::Deploy {
                 path: "/m.hsm".into(),
                 force: false,
+                confirmed: false,
+                check_only: false,
             },
             Request::Deploy {
                 path: "/m.hsm".into(),
                 force: true,
+                confirmed: true,
+                check_only: true,
             },
         ] {
             let line = serde_json::to_string(&r).unwrap();
@@ -366,7 +387,9 @@ mod tests {
             parse_request(r#"{"cmd":"deploy","path":"/abs/model.hsm"}"#).unwrap(),
             Request::Deploy {
                 path: "/abs/model.hsm".into(),
-                force: false
+                force: false,
+                confirmed: false,
+                check_only: false,
             }
         );
         assert_eq!(
@@ -375,6 +398,10 @@ mod tests {
         );
         for (line, want) in [
             (r#"{"cmd":"deploy","path":7}"#, "field `path`"),
+            (
+                r#"{"cmd":"deploy","path":"/m","confirmed":1}"#,
+                "field `confirmed`",
+            ),
             (
                 r#"{"cmd":"deploy","path":"/m","force":"yes"}"#,
                 "field `force`",

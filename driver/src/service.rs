@@ -189,7 +189,18 @@ impl ControlHandler {
             },
             Request::Tune { finger, kf, kalpha } => self.tune(&finger, kf, kalpha, &user),
             Request::Calibrating => self.calibrating(peer, &user),
-            Request::Deploy { path, force } => self.deploy(&path, force, peer, &user),
+            Request::Deploy {
+                path,
+                force,
+                check_only: true,
+                ..
+            } => self.check_deploy(&path, force),
+            Request::Deploy {
+                path,
+                force,
+                confirmed,
+                check_only: false,
+            } => self.deploy(&path, force, confirmed, peer, &user),
             Request::Rollback => self.rollback(peer, &user),
             Request::Arm {
                 force_rest_mismatch,

@@ -126,6 +126,8 @@ impl LoadedModel {
             kind: self.model.summary().kind.to_string(),
             verification: decoder::model::verify::describe_verification(v),
             unverified: !v.is_some_and(|r| r.passed()),
+            patient: self.model.provenance().and_then(|p| p.patient.clone()),
+            provenance: decoder::model::provenance::describe_provenance(self.model.provenance()),
         }
     }
 

@@ -122,6 +122,10 @@ pub struct DeployArgs {
     /// Deploy a model whose file records no verification, or a failed one.
     #[arg(long)]
     pub force: bool,
+    /// Do not ask: deploy even when the model's patient differs from the running model's (or
+    /// either is unknown). Without it, and without a terminal to ask on, such a deploy fails.
+    #[arg(long)]
+    pub yes: bool,
     #[command(flatten)]
     pub daemon: DaemonOpts,
 }
@@ -286,6 +290,11 @@ pub struct TrainArgs {
     /// Model file to write (atomically).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// The patient's id, recorded in the model file (letters, digits, '.', '_', '-'; at most
+    /// 64): `handctl deploy` asks before a model for another patient replaces the running one.
+    /// Without it the file records no patient ("unknown patient").
+    #[arg(long, value_parser = parse_patient)]
+    pub patient: Option<String>,
     /// Model architecture.
     #[arg(long, default_value = "resdd", value_parser = parse_kind)]
     pub model: ModelKind,
@@ -323,6 +332,10 @@ fn parse_resume_age(s: &str) -> Result<u64, String> {
     } else {
         Err(format!("{v}: must be 1 to {max} minutes"))
     }
+}
+
+fn parse_patient(s: &str) -> Result<String, String> {
+    decoder::model::provenance::check_patient_id(s).map(|()| s.to_owned())
 }
 
 fn parse_tolerance(s: &str) -> Result<f64, String> {
@@ -510,6 +523,11 @@ pub struct CalibrateArgs {
     /// No questions; plain progress lines instead of the live screen.
     #[arg(long)]
     pub yes: bool,
+    /// The patient's id, recorded in the model file (letters, digits, '.', '_', '-'; at most
+    /// 64): `handctl deploy` asks before a model for another patient replaces the running one.
+    /// Without it the file records no patient ("unknown patient").
+    #[arg(long, value_parser = parse_patient)]
+    pub patient: Option<String>,
     /// Continue an interrupted calibration in --out from its next trial (after 3 s of the
     /// patient relaxed, compared with the session's rest trials).
     #[arg(long)]

@@ -49,12 +49,17 @@ pub(crate) fn done(reply: Reply) -> Result<Option<Status>, CliError> {
 fn format_model(s: &Status) -> String {
     match &s.model {
         Some(m) => format!(
-            "model {} ({}, id {})\n{}{}\n",
+            "model {} ({}, id {})\n{}{}\n{}\n",
             m.path,
             m.kind,
             m.id,
             if m.unverified { "!! " } else { "" },
-            m.verification
+            m.verification,
+            if m.provenance.is_empty() {
+                "unknown patient (this handd does not report provenance)"
+            } else {
+                &m.provenance
+            }
         ),
         None => "model: not reported by this handd\n".into(),
     }
@@ -189,6 +194,8 @@ mod tests {
             kind: "resdd".into(),
             verification: verification.into(),
             unverified,
+            patient: Some("P-017".into()),
+            provenance: "patient P-017, session fitting-1, calibrated 2026-12-02T13:15:28Z".into(),
         };
         let mut s = Status {
             model: Some(model(
@@ -201,7 +208,8 @@ mod tests {
         assert!(
             text.starts_with(
                 "model /var/lib/handstack/model.hsm (resdd, id 0badf00d)\n\
-                 verified: 0 of 3375 rays reverse beyond 0.01 (exact)\n"
+                 verified: 0 of 3375 rays reverse beyond 0.01 (exact)\n\
+                 patient P-017, session fitting-1, calibrated 2026-12-02T13:15:28Z\n"
             ),
             "{text}"
         );

@@ -73,6 +73,16 @@ pub enum CliError {
         /// The verification, naming the worst finger, trial and amount.
         verdict: String,
     },
+    /// `handctl deploy`: the model's patient differs from the running model's (or either is
+    /// unknown), and there was neither `--yes` nor a terminal to ask on.
+    #[error(
+        "not deployed: {change}. Check that this is the right patient's model, then pass --yes \
+         (stdin is not a terminal, so nothing was asked)"
+    )]
+    Unconfirmed {
+        /// Both patients, in words.
+        change: String,
+    },
     /// A model could not be put together (e.g. a record that contradicts itself).
     #[error("model: {0}")]
     Model(#[from] decoder::model::ModelError),
@@ -86,11 +96,12 @@ pub enum CliError {
 
 impl CliError {
     /// Process exit code: 3 for refused quality gates, 4 for a model refused by its
-    /// verification, 1 otherwise.
+    /// verification, 5 for a deploy to another patient not confirmed, 1 otherwise.
     pub fn exit_code(&self) -> u8 {
         match self {
             CliError::Gates(_) => 3,
             CliError::Refused { .. } => 4,
+            CliError::Unconfirmed { .. } => 5,
             _ => 1,
         }
     }

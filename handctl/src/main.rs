@@ -35,7 +35,8 @@ use args::{Cli, Command};
 
 /// Parses the command line, runs the command, prints an error and returns the exit code
 /// (0 success, 1 failure, 2 usage error from clap, 3 quality gates refused the session, 4 the
-/// trained model reverses on a calibration ray and was not written).
+/// trained model reverses on a calibration ray and was not written, 5 a deploy to another
+/// patient was not confirmed).
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {

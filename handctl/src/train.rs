@@ -1,6 +1,7 @@
 //! `handctl train` and `handctl check`.
 
-use decoder::model::{train, Dataset, ModelKind, ModelSpec, TrainConfig, TrainedModel};
+use decoder::model::provenance::{describe_provenance, utc_now};
+use decoder::model::{train, Dataset, ModelKind, ModelSpec, Provenance, TrainConfig, TrainedModel};
 use decoder::session::{check_gates, GateConfig, LabelledWindows, Session, WindowOptions};
 
 use super::args::{CheckArgs, TrainArgs, TrainingOpts};
@@ -8,21 +9,61 @@ use super::error::CliError;
 use super::progress::Progress;
 
 /// Runs the quality gates, printing the report to stderr; an error when they fail and the
-/// user did not say to go on anyway.
-pub(super) fn gate(session: &Session, opts: &TrainingOpts) -> Result<(), CliError> {
+/// user did not say to go on anyway. Returns the findings bypassed (`--ignore-gates`), for the
+/// model file's provenance.
+pub(super) fn gate(session: &Session, opts: &TrainingOpts) -> Result<Vec<String>, CliError> {
     let report = check_gates(session, &GateConfig::default())?;
     if report.passed() {
         for n in &report.notes {
             eprintln!("{}: note: {n}", session.name.display());
         }
-        return Ok(());
+        return Ok(Vec::new());
     }
     eprint!("{}: quality gates:\n{report}", session.name.display());
     if opts.ignore_gates {
-        eprintln!("--ignore-gates: training anyway");
-        Ok(())
+        eprintln!("--ignore-gates: training anyway (the model file records the findings bypassed)");
+        Ok(report.issues.iter().map(|i| i.message.clone()).collect())
     } else {
         Err(CliError::Gates(report.issues.len()))
+    }
+}
+
+/// The session's id for the model file: the session directory's name, or the spec as given
+/// for a session that is not a directory (`3dc:DIR:train`), at most
+/// [`decoder::model::provenance::MAX_SESSION_ID`] characters.
+pub(super) fn session_id(spec: &str) -> String {
+    std::fs::canonicalize(spec)
+        .ok()
+        .filter(|d| d.is_dir())
+        .and_then(|d| d.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .unwrap_or_else(|| spec.to_owned())
+        .chars()
+        .filter(|c| !c.is_control())
+        .take(decoder::model::provenance::MAX_SESSION_ID)
+        .collect()
+}
+
+/// The provenance recorded in the model file: `patient` (from `--patient`), the session's id,
+/// now (UTC) as the calibration date (`session.toml` records none), and the gate findings
+/// training went past. Says on stderr when no patient is recorded.
+pub(super) fn provenance(
+    patient: Option<&str>,
+    session: String,
+    opts: &TrainingOpts,
+    gates_bypassed: Vec<String>,
+) -> Provenance {
+    if patient.is_none() {
+        eprintln!(
+            "no --patient: the model file records no patient id (\"unknown patient\"); \
+             handctl deploy asks before it replaces a running model with it"
+        );
+    }
+    Provenance {
+        patient: patient.map(str::to_owned),
+        session,
+        calibrated_utc: utc_now(),
+        ignore_gates: opts.ignore_gates,
+        gates_bypassed,
     }
 }
 
@@ -106,7 +147,13 @@ fn rest_level(
 /// passes (or with `--force`, recorded as forced); a refused model leaves no file behind.
 pub fn run(a: &TrainArgs) -> Result<(), CliError> {
     let session = Session::open_spec(&a.session)?;
-    gate(&session, &a.training)?;
+    let bypassed = gate(&session, &a.training)?;
+    let record = provenance(
+        a.patient.as_deref(),
+        session_id(&a.session),
+        &a.training,
+        bypassed,
+    );
     let windows = session.windows(&window_options(&a.training))?;
     let data = windows.to_dataset(&session.meta.chain)?;
     let model = fit(a.model, &data, &a.training)?;
@@ -116,8 +163,10 @@ pub fn run(a: &TrainArgs) -> Result<(), CliError> {
         Some(levels) => model.with_rest_rms_uv(levels)?,
         None => model,
     };
+    let model = model.with_provenance(record)?;
     model.save(&a.output)?;
     println!("wrote {}", a.output.display());
+    println!("{}", describe_provenance(model.provenance()));
     Ok(())
 }
 

@@ -154,6 +154,11 @@ fn train_and_verify_agree_on_the_effort_rays() {
     let out = train(&[]);
     let o = text(&out.stdout);
     assert_eq!(out.status.code(), Some(4), "{o}{}", text(&out.stderr));
+    assert!(
+        text(&out.stderr).contains("no --patient: the model file records no patient id"),
+        "{}",
+        text(&out.stderr)
+    );
     assert!(!model.exists());
     let line = o
         .lines()
@@ -162,8 +167,20 @@ fn train_and_verify_agree_on_the_effort_rays() {
     let refused = counts(line);
     assert!(refused.0 > 0 && refused.1 > refused.0, "{line}");
     // Written with --force, `handctl verify` on the same session finds the very same rays.
-    let out = train(&["--force"]);
+    let out = train(&["--force", "--patient", "P-006"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
+    let o = text(&out.stdout);
+    assert!(
+        o.contains(&format!("patient P-006, session {spec}, calibrated 20")),
+        "the provenance line: {o}"
+    );
+    let out = train(&["--patient", "P 006"]);
+    assert_eq!(
+        out.status.code(),
+        Some(2),
+        "a bad patient id is a usage error"
+    );
+    assert!(text(&out.stderr).contains("' ' is not allowed"));
     let out = handctl(&["verify", "--model", s(&model), &spec]);
     let o = text(&out.stdout);
     assert!(o.contains("ln effort-ray check, exact"), "{o}");
@@ -419,9 +436,16 @@ fn train_refuses_a_reversing_model_force_records_it_and_eval_scores_the_file() {
         "nothing written, no partial file: {left:?}"
     );
 
-    let out = train(&["--force"]);
+    let out = train(&["--force", "--patient", "P-006"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let m = decoder::model::TrainedModel::load(&model, None).unwrap();
+    // The session's id is its directory's name.
+    let origin = m.provenance().expect("train records the provenance");
+    let name = session.file_name().unwrap().to_string_lossy();
+    assert_eq!(
+        (origin.patient.as_deref(), origin.session.as_str()),
+        (Some("P-006"), name.as_ref())
+    );
     let v = m.verification().expect("the file records its verification");
     assert!(v.forced && v.reversing > 0 && v.rays > 0, "{v:?}");
     assert_eq!(v.method, decoder::model::verify::Method::Exact);

@@ -176,8 +176,15 @@ fn saved_model(path: &std::path::Path, chain: decoder::dsp::ChainConfig, seed: u
 /// Runs `handctl ARGS` while the loop ticks on (a deploy waits for its tick); returns whether
 /// it succeeded and what it printed (stdout, then stderr).
 fn handctl_while_ticking(rig: &mut Rig, args: &[&str]) -> (bool, String) {
+    let (code, text) = handctl_code_while_ticking(rig, args);
+    (code == Some(0), text)
+}
+
+/// [`handctl_while_ticking`] with the exit code; stdin is not a terminal, as in a script.
+fn handctl_code_while_ticking(rig: &mut Rig, args: &[&str]) -> (Option<i32>, String) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_handctl"))
         .args(args)
+        .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -194,7 +201,7 @@ fn handctl_while_ticking(rig: &mut Rig, args: &[&str]) -> (bool, String) {
         String::from_utf8_lossy(&out.stdout),
         String::from_utf8_lossy(&out.stderr)
     );
-    (out.status.success(), text)
+    (out.status.code(), text)
 }
 
 /// HAND_HEARTBEAT's model ids seen from `from_us` on, with their times.
@@ -363,8 +370,30 @@ fn calibrating_hold_deploy_refusals_swap_and_rollback() {
     // The good one: swapped at a tick, the config names its installed copy, still held.
     let before = rig.runner.engine().counters();
     let deploy_at = rig.clock_now();
-    let (ok, said) =
-        handctl_while_ticking(&mut rig, &["deploy", good.to_str().unwrap(), "--socket", s]);
+    // Both files record no patient: a script without --yes fails at once, nothing changed.
+    let (code, said) =
+        handctl_code_while_ticking(&mut rig, &["deploy", good.to_str().unwrap(), "--socket", s]);
+    assert_eq!(code, Some(5), "{said}");
+    assert!(
+        said.contains("this model is for unknown patient") && said.contains("pass --yes"),
+        "{said}"
+    );
+    assert_eq!(Config::load(&config_path).unwrap().model, config.model);
+    // A hand-written request cannot skip the question: handd refuses it too.
+    let path = good.to_str().unwrap().to_owned();
+    match ask(Request::Deploy {
+        path: path.clone(),
+        force: false,
+        confirmed: false,
+        check_only: false,
+    }) {
+        Reply::Refused { reason } => assert!(reason.contains("confirmation"), "{reason}"),
+        r => panic!("an unconfirmed deploy: {r:?}"),
+    }
+    let (ok, said) = handctl_while_ticking(
+        &mut rig,
+        &["deploy", good.to_str().unwrap(), "--yes", "--socket", s],
+    );
     assert!(ok, "{said}");
     assert!(said.contains(&format!("{id_b:08x}")), "{said}");
     rig.run_until(rig.clock_now() + 500_000);

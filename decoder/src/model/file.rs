@@ -15,16 +15,19 @@
 //! the list of parameter tensors (name and shape, in storage order), the normalizer's shape and
 //! the training summary; then, when known, the verification of the calibration rays
 //! (`verification`, see [`VerificationRecord`]) and the calibration's rest level per channel
-//! (`rest_rms_uv`). Files written before those two existed have neither and still load ("not
-//! verified"). Everything in the body, these included, is covered by the checksum. Weights are
-//! raw IEEE-754 doubles so they load bit for bit.
+//! (`rest_rms_uv`), and which patient and session it was calibrated on (`provenance`, see
+//! [`Provenance`]: patient id, session id, calibration date, the quality gates bypassed). Files
+//! written before those existed lack them and still load ("not verified", "unknown patient").
+//! Everything in the body, these included, is covered by the checksum. Weights are raw
+//! IEEE-754 doubles so they load bit for bit.
 //!
 //! Versions. Version 2 lists in `required` every metadata section present that changes what
 //! the model outputs (today `rest_stage`, the dead zone at rest, and `envelope`, the
 //! calibration's envelope its inputs are held inside: [`super::Envelope`]); a reader refuses a
 //! file whose `required` names a section it does not know ([`FileError::UnknownRequired`]), so
-//! a newer file is never run with part of its behaviour silently dropped. Sections that only describe the
-//! model (`verification`, `rest_rms_uv`, the summary) are not required: an older reader may
+//! a newer file is never run with part of its behaviour silently dropped. Sections that only
+//! describe the model (`verification`, `rest_rms_uv`, `provenance`, the summary) are not
+//! required: an older reader may
 //! ignore them. A new section that changes the outputs goes into `required` (and this build's
 //! [`KNOWN_REQUIRED`]); a change of the layout itself bumps [`FORMAT_VERSION`]. This build
 //! reads versions 1 (written before `required` existed; its optional sections are read as
@@ -48,6 +51,7 @@ use super::dataset::N_FINGERS;
 use super::error::FileError;
 use super::kind::ModelKind;
 use super::normalizer::Normalizer;
+use super::provenance::Provenance;
 use super::rest::RestStage;
 use super::spec::ModelSpec;
 use super::summary::TrainingSummary;
@@ -102,6 +106,9 @@ struct Meta {
     /// Per input feature, the calibration's largest value (absent in older files).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     envelope: Option<Vec<f64>>,
+    /// Absent in older files: which patient and session (descriptive, never required).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    provenance: Option<Provenance>,
     /// The sections present that change the outputs (version 2 on; see the module docs).
     #[serde(default)]
     required: Vec<String>,
@@ -347,6 +354,7 @@ fn with_records(
     verification: Option<VerificationRecord>,
     rest: Option<Vec<f64>>,
     stage: Option<RestStage>,
+    provenance: Option<Provenance>,
 ) -> Result<TrainedModel, FileError> {
     let malformed =
         |what: &str, e: super::error::ModelError| FileError::Malformed(format!("{what}: {e}"));
@@ -364,6 +372,11 @@ fn with_records(
         let checked = RestStage::try_new(*st.up(), *st.down(), st.sharpness())
             .map_err(|e| malformed("rest_stage", e))?;
         model = model.with_rest_stage(Some(checked));
+    }
+    if let Some(p) = provenance {
+        model = model
+            .with_provenance(p)
+            .map_err(|e| malformed("provenance", e))?;
     }
     Ok(model)
 }
@@ -405,6 +418,7 @@ impl TrainedModel {
             rest_rms_uv: self.rest_rms_uv.clone(),
             rest_stage: self.rest_stage,
             envelope: self.envelope.as_ref().map(|e| e.max().to_vec()),
+            provenance: self.provenance.clone(),
             required: [
                 self.rest_stage.is_some().then_some("rest_stage"),
                 self.envelope.is_some().then_some("envelope"),
@@ -460,6 +474,7 @@ impl TrainedModel {
             meta.verification,
             meta.rest_rms_uv,
             meta.rest_stage,
+            meta.provenance,
         )?;
         match meta.envelope {
             Some(max) => {

@@ -9,6 +9,7 @@
 //!   every trial), deterministic for a given seed.
 //! - [`RestStage`]: a soft dead zone per finger fitted from the calibration's rest windows, so a
 //!   relaxed hand stays still (monotonic, keeps ±1 at ±1).
+//! - [`Provenance`]: which patient, which session, when, and any quality gates bypassed.
 //! - [`TrainedModel`]: what a model file holds ([`TrainedModel::save`] / [`TrainedModel::load`]);
 //!   [`Predictor`] runs it in the daemon's tick.
 //!
@@ -39,6 +40,7 @@ mod linalg;
 mod matvec_x86;
 mod normalizer;
 mod optim;
+pub mod provenance;
 mod resdd;
 mod resdd_batch;
 mod rest;
@@ -62,6 +64,7 @@ pub use error::{FileError, ModelError, TrainError};
 pub use file::{FORMAT_VERSION, HEADER_LEN, MAGIC, NORMALIZER_TENSOR};
 pub use kind::ModelKind;
 pub use normalizer::Normalizer;
+pub use provenance::Provenance;
 pub use resdd::{ResDd, ResDdActivations, RESDD_INPUT_GAIN};
 pub use rest::{RestFit, RestStage, MAX_REST_WIDTH, REST_SHARPNESS};
 pub use spec::{

@@ -8,6 +8,7 @@ use super::dataset::N_FINGERS;
 use super::envelope::Envelope;
 use super::error::ModelError;
 use super::normalizer::Normalizer;
+use super::provenance::Provenance;
 use super::rest::RestStage;
 use super::spec::ModelSpec;
 use super::summary::TrainingSummary;
@@ -15,8 +16,8 @@ use super::traits::{Model, Scratch, Trainable};
 use super::verify::VerificationRecord;
 
 /// Model + normalizer + chain configuration + training summary (what a model file holds), and
-/// optionally the verification of its calibration rays, the calibration's rest level and the
-/// rest stage applied to the outputs.
+/// optionally the verification of its calibration rays, the calibration's rest level, the
+/// rest stage applied to the outputs and the calibration's provenance (patient, session, date).
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrainedModel {
     pub(crate) model: AnyModel,
@@ -28,6 +29,7 @@ pub struct TrainedModel {
     pub(crate) rest_rms_uv: Option<Vec<f64>>,
     pub(crate) rest_stage: Option<RestStage>,
     pub(crate) envelope: Option<Envelope>,
+    pub(crate) provenance: Option<Provenance>,
 }
 
 impl TrainedModel {
@@ -84,6 +86,7 @@ impl TrainedModel {
             rest_rms_uv: None,
             rest_stage: None,
             envelope: None,
+            provenance: None,
         })
     }
 
@@ -140,6 +143,22 @@ impl TrainedModel {
         }
         self.rest_rms_uv = Some(levels);
         Ok(self)
+    }
+
+    /// The model with `record` as its provenance (replacing any earlier one). Refuses a record
+    /// that is malformed ([`Provenance::check`]).
+    pub fn with_provenance(mut self, record: Provenance) -> Result<Self, ModelError> {
+        record
+            .check()
+            .map_err(|e| ModelError::InvalidSpec(format!("provenance: {e}")))?;
+        self.provenance = Some(record);
+        Ok(self)
+    }
+
+    /// Which patient and session the model was calibrated on (None: an older file, "unknown
+    /// patient").
+    pub fn provenance(&self) -> Option<&Provenance> {
+        self.provenance.as_ref()
     }
 
     /// The model with `stage` applied to its outputs (see [`RestStage`]), or without a stage.

@@ -211,12 +211,32 @@ fn train_and_summarize(dir: &Path) {
         ignore_gates: false,
         validation: None,
     };
-    let trained =
-        super::training::train_session(dir, &opts, decoder::model::verify::DEFAULT_TOLERANCE)
-            .expect("a verified model");
+    let trained = super::training::train_session(
+        dir,
+        &opts,
+        decoder::model::verify::DEFAULT_TOLERANCE,
+        Some("P-001"),
+    )
+    .expect("a verified model");
     assert!(trained.path.exists());
-    decoder::model::TrainedModel::load(&trained.path, Some(&trained.session.meta.chain))
-        .expect("the model file loads");
+    let loaded =
+        decoder::model::TrainedModel::load(&trained.path, Some(&trained.session.meta.chain))
+            .expect("the model file loads");
+    let origin = loaded
+        .provenance()
+        .expect("calibrate records the provenance");
+    let dir_name = dir
+        .file_name()
+        .expect("a named directory")
+        .to_string_lossy();
+    assert_eq!(
+        (
+            origin.patient.as_deref(),
+            origin.session.as_str(),
+            origin.ignore_gates
+        ),
+        (Some("P-001"), dir_name.as_ref(), false)
+    );
     let fingers = super::summary::summarize(&trained);
     let index = fingers[1];
     assert!(index.windows > 0 && index.monotonic, "{index:?}");

@@ -100,7 +100,7 @@ pub fn run(a: &CalibrateArgs) -> Result<(), CliError> {
         done.frames,
         done.repeats.len()
     ));
-    let trained = training::train_session(&a.out, &a.training, a.tolerance)?;
+    let trained = training::train_session(&a.out, &a.training, a.tolerance, a.patient.as_deref())?;
     print!(
         "{}",
         summary::render(&trained, &summary::summarize(&trained))

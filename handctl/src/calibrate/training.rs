@@ -11,7 +11,7 @@ use decoder::session::{check_gates, GateConfig, LabelledWindows, Session, Window
 
 use crate::args::TrainingOpts;
 use crate::error::CliError;
-use crate::train::{describe, fit, window_options};
+use crate::train::{describe, fit, provenance, window_options};
 
 /// The model file inside the output directory.
 pub const MODEL_FILE: &str = "model.hsm";
@@ -32,8 +32,14 @@ pub struct Trained {
     pub description: String,
 }
 
-/// Gates, training, verification and the model file (see the module docs).
-pub fn train_session(dir: &Path, opts: &TrainingOpts, tolerance: f64) -> Result<Trained, CliError> {
+/// Gates, training, verification and the model file (see the module docs); the file records
+/// `patient`, the session (the directory's name), the date and any gate findings bypassed.
+pub fn train_session(
+    dir: &Path,
+    opts: &TrainingOpts,
+    tolerance: f64,
+    patient: Option<&str>,
+) -> Result<Trained, CliError> {
     let session = Session::open(dir)?;
     let gates = check_gates(&session, &GateConfig::default())?;
     if !gates.passed() {
@@ -42,6 +48,13 @@ pub fn train_session(dir: &Path, opts: &TrainingOpts, tolerance: f64) -> Result<
             return Err(CliError::Gates(gates.issues.len()));
         }
     }
+    let bypassed = gates.issues.iter().map(|i| i.message.clone()).collect();
+    let origin = provenance(
+        patient,
+        crate::train::session_id(&dir.display().to_string()),
+        opts,
+        bypassed,
+    );
     let train_windows = session.windows(&window_options(opts))?;
     let data = train_windows.to_dataset(&session.meta.chain)?;
     let model = fit(ModelKind::ResDd, &data, opts)?;
@@ -55,7 +68,7 @@ pub fn train_session(dir: &Path, opts: &TrainingOpts, tolerance: f64) -> Result<
             verdict: format!("the {} model {record}", report.kind),
         });
     }
-    let mut model = model.with_verification(record)?;
+    let mut model = model.with_verification(record)?.with_provenance(origin)?;
     if let Some(levels) = windows.rest_rms(&session.meta.trials) {
         model = model.with_rest_rms_uv(levels)?;
     }

@@ -71,7 +71,13 @@ pub(super) fn calibrate_deploy_arm(env: &VcanEnv) -> PathBuf {
     let model = out.join("model.hsm");
     handctl(
         env,
-        &["deploy", &model.display().to_string(), "--socket", &sock],
+        &[
+            "deploy",
+            &model.display().to_string(),
+            "--yes",
+            "--socket",
+            &sock,
+        ],
     );
     // The patient back on the amplifier (a new handsim: the cued one is gone), then arm, as a
     // technician arms with the electrodes streaming.

@@ -113,7 +113,10 @@ fn deploy_refuses_bad_models_swaps_a_good_one_and_rolls_back() {
         "{said}"
     );
     std::thread::sleep(Duration::from_millis(500));
+    // Both files record no patient: deploy asks, and a script says yes with --yes.
     let (ok, said) = handctl_any(&rig, &["deploy", &second]);
+    assert!(!ok && said.contains("pass --yes"), "{said}");
+    let (ok, said) = handctl_any(&rig, &["deploy", &second, "--yes"]);
     assert!(ok && said.contains(&format!("{id_b:08x}")), "{said}");
     let deployed = now_us();
     let armed = arm_after(&rig, 500);
