@@ -1,7 +1,9 @@
 //! `handctl train` and `handctl check`.
 
 use decoder::model::{train, Dataset, ModelKind, ModelSpec, TrainConfig, TrainedModel};
-use decoder::session::{check_gates, GateConfig, LabelledWindows, Session, WindowOptions};
+use decoder::session::{
+    check_gates, GateConfig, GateReport, LabelledWindows, Session, WindowOptions,
+};
 
 use super::args::{CheckArgs, TrainArgs, TrainingOpts};
 use super::error::CliError;
@@ -18,11 +20,28 @@ pub(super) fn gate(session: &Session, opts: &TrainingOpts) -> Result<(), CliErro
         return Ok(());
     }
     eprint!("{}: quality gates:\n{report}", session.name.display());
+    overrule(&report, opts)
+}
+
+/// Whether training may go on despite the gates' `report` (which did not pass): only with
+/// `--ignore-gates`, and a finger moved in one direction only also needs
+/// `--allow-one-direction` (see [`decoder::session::GateKind::can_be_ignored`]).
+pub(crate) fn overrule(report: &GateReport, opts: &TrainingOpts) -> Result<(), CliError> {
+    let binding = report.binding().count();
+    if binding > 0 && !opts.allow_one_direction {
+        return Err(CliError::OneDirection(binding));
+    }
+    if binding > 0 {
+        eprintln!("--allow-one-direction: {binding} finger(s) trained in one direction only");
+    }
+    if report.issues.len() == binding {
+        return Ok(());
+    }
     if opts.ignore_gates {
         eprintln!("--ignore-gates: training anyway");
         Ok(())
     } else {
-        Err(CliError::Gates(report.issues.len()))
+        Err(CliError::Gates(report.issues.len() - binding))
     }
 }
 

@@ -38,9 +38,7 @@ pub fn train_session(dir: &Path, opts: &TrainingOpts, tolerance: f64) -> Result<
     let gates = check_gates(&session, &GateConfig::default())?;
     if !gates.passed() {
         eprint!("{}: quality gates:\n{gates}", dir.display());
-        if !opts.ignore_gates {
-            return Err(CliError::Gates(gates.issues.len()));
-        }
+        crate::train::overrule(&gates, opts)?;
     }
     let train_windows = session.windows(&window_options(opts))?;
     let data = train_windows.to_dataset(&session.meta.chain)?;
