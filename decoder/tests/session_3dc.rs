@@ -91,3 +91,55 @@ fn import_writes_a_session_that_opens_the_same() {
     assert!(e.contains("validation"), "{e}");
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+fn rec_range(s: &Session, t: &decoder::session::Trial) -> std::ops::Range<usize> {
+    s.recording.range_of(t.start_us, t.end_us)
+}
+
+/// Issue 32 item 3: no false refusals. The gates (the pattern gates included) pass all six 3DC
+/// sessions (P4, P6, P7, train and test); their pattern figures are printed. With the flexions'
+/// samples copied over the extensions' (the participant made a fist at every cue), each session
+/// is refused.
+#[test]
+fn the_gates_pass_all_six_sessions_and_refuse_them_with_flexion_at_every_cue() {
+    let shared = data_dir().join("..");
+    for who in ["p4", "p6", "p7"] {
+        for split in [Split::Train, Split::Test] {
+            let s = load_3dc(&shared.join(format!("3dc-armband-{who}")), split).unwrap();
+            let r = check_gates(&s, &GateConfig::default()).unwrap();
+            println!("3dc {who} {}:\n{r}", split.name());
+            assert!(r.passed(), "{who} {} refused:\n{r}", split.name());
+            assert_eq!(r.patterns.len(), 1, "the whole hand: {r}");
+            // The flexions' samples copied over the extensions' (4 recordings of each).
+            let mut rec = s.recording.clone();
+            let ranges = |kind| -> Vec<std::ops::Range<usize>> {
+                s.meta
+                    .trials
+                    .iter()
+                    .filter(|t| t.kind == kind)
+                    .map(|t| rec_range(&s, t))
+                    .collect()
+            };
+            let ch = rec.channels;
+            for (f, e) in ranges(TrialKind::Flexion)
+                .into_iter()
+                .zip(ranges(TrialKind::Extension))
+            {
+                let n = f.len().min(e.len()) * ch;
+                let from = s.recording.samples[f.start * ch..f.start * ch + n].to_vec();
+                rec.samples[e.start * ch..e.start * ch + n].copy_from_slice(&from);
+            }
+            let same = Session::from_parts(s.name.clone(), s.meta.clone(), rec).unwrap();
+            let r = check_gates(&same, &GateConfig::default()).unwrap();
+            println!("{who} {}, a fist at every cue:\n{r}", split.name());
+            assert!(
+                r.issues
+                    .iter()
+                    .any(|i| i.kind
+                        == decoder::session::GateKind::FlexionLikeExtension { finger: None }),
+                "{who} {}: {r}",
+                split.name()
+            );
+        }
+    }
+}

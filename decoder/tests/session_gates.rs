@@ -26,8 +26,24 @@ fn a_clean_session_passes() {
     let s = session_of(&clean_protocol(), 10, |_, _| {});
     let r = check_gates(&s, &GateConfig::default()).unwrap();
     assert!(r.passed(), "{r}");
-    assert!(r.notes.is_empty());
+    // Fingers 2..4 are in no trial: said once, not a refusal.
+    assert_eq!(r.notes.len(), 1, "{r}");
+    assert!(
+        r.notes[0].contains("middle, ring, pinky: trained toward 0 only"),
+        "{r}"
+    );
     assert!(r.to_string().contains("all quality gates passed"));
+    // The pattern figures of both fingers: repetitions alike, flexion unlike extension.
+    assert_eq!(r.patterns.len(), 2, "{r}");
+    for p in &r.patterns {
+        assert_eq!(p.repetitions.len(), 4, "{p}");
+        assert!(p.repetitions.iter().all(|x| x.2 > 0.99), "{p}");
+        assert!(p.flexion_extension.expect("both kinds") < 0.5, "{p}");
+        assert_eq!(
+            p.swap_score, None,
+            "two movements: no reference for the swap gate"
+        );
+    }
 }
 
 #[test]
@@ -157,8 +173,9 @@ fn without_rest_the_contrast_gate_says_it_did_not_run() {
     let s = session_of(&trials, 15, |_, _| {});
     let r = check_gates(&s, &GateConfig::default()).unwrap();
     assert!(r.passed(), "{r}");
-    assert_eq!(r.notes.len(), 1);
-    assert!(r.notes[0].contains("no rest trial"));
+    assert!(r.notes.iter().any(|n| n.contains("no rest trial")), "{r}");
+    // Without rest, the profiles are compared without subtracting a rest level.
+    assert_eq!(r.patterns.len(), 2, "{r}");
 }
 
 #[test]
@@ -185,4 +202,266 @@ fn a_trial_broken_into_short_pieces_gives_no_window_and_says_why() {
             && m.contains("200 ms of unbroken"),
         "{m}"
     );
+}
+
+/// The clean protocol with a third round (rest, fingers 0 and 1 flexion and extension).
+fn three_rounds() -> Vec<SynthTrial> {
+    let mut v = clean_protocol();
+    let third: Vec<SynthTrial> = v[..5]
+        .iter()
+        .map(|t| SynthTrial {
+            repetition: 3,
+            ..t.clone()
+        })
+        .collect();
+    v.extend(third);
+    v
+}
+
+fn issues_of(r: &decoder::session::GateReport, kind: GateKind) -> Vec<u32> {
+    r.issues
+        .iter()
+        .filter(|i| i.kind == kind)
+        .map(|i| i.trial_id)
+        .collect()
+}
+
+#[test]
+fn a_trial_with_too_few_windows_is_caught() {
+    let (samples, mut meta) = synth(&clean_protocol(), 17);
+    // Trial 4 (finger 1 flexion) lasts 0.3 s: 3 windows of 200 ms at the 50 ms step.
+    let t = meta.trials.iter_mut().find(|t| t.id == 4).unwrap();
+    t.end_us = t.start_us + 300_000;
+    let rec = decoder::session::Recording::from_samples(CHANNELS, samples, RATE).unwrap();
+    let s = Session::from_parts("synthetic".into(), meta, rec).unwrap();
+    let r = check_gates(&s, &GateConfig::default()).unwrap();
+    let few: Vec<_> = r
+        .issues
+        .iter()
+        .filter(|i| matches!(i.kind, GateKind::FewWindows { .. }))
+        .collect();
+    assert_eq!(few.len(), 1, "{r}");
+    assert_eq!(
+        (few[0].trial_id, few[0].kind),
+        (4, GateKind::FewWindows { windows: 3 })
+    );
+    assert!(
+        few[0].message.contains("at least 5") && few[0].message.contains("400 ms of hold"),
+        "{r}"
+    );
+    // Left out of the pattern gates, which say so.
+    assert!(
+        r.notes
+            .iter()
+            .any(|n| n.contains("single usable repetition of index flexion")),
+        "{r}"
+    );
+    assert_eq!(decoder::session::MIN_WINDOWS_PER_TRIAL, 5);
+}
+
+#[test]
+fn a_repetition_with_another_pattern_is_caught() {
+    let mut trials = three_rounds();
+    // Trial 7 (finger 0 flexion, repetition 2): the patient extended instead.
+    assert_eq!(
+        (trials[6].finger, trials[6].kind, trials[6].repetition),
+        (Some(0), TrialKind::Flexion, 2)
+    );
+    trials[6].amps = trials[2].amps;
+    let s = session_of(&trials, 18, |_, _| {});
+    let r = check_gates(&s, &GateConfig::default()).unwrap();
+    assert_eq!(issues_of(&r, GateKind::InconsistentPattern), vec![7], "{r}");
+    let m = &r.issues.iter().find(|i| i.trial_id == 7).unwrap().message;
+    assert!(
+        m.contains("trial(s) 2, 12") && m.contains("another movement"),
+        "{m}"
+    );
+    // Nothing else: same effort, contrast and channels.
+    assert!(
+        r.issues
+            .iter()
+            .all(|i| i.kind == GateKind::InconsistentPattern),
+        "{r}"
+    );
+}
+
+#[test]
+fn a_finger_whose_flexion_is_its_extension_is_refused() {
+    let mut trials = clean_protocol();
+    // The patient extends finger 0 at every flexion cue.
+    for rep in [0, 5] {
+        trials[rep + 1].amps = trials[rep + 2].amps;
+    }
+    let s = session_of(&trials, 19, |_, _| {});
+    let r = check_gates(&s, &GateConfig::default()).unwrap();
+    let same = issues_of(&r, GateKind::FlexionLikeExtension { finger: Some(0) });
+    assert_eq!(same, vec![2], "reported on the first flexion: {r}");
+    let m = &r.issues.iter().find(|i| i.trial_id == 2).unwrap().message;
+    assert!(
+        m.contains("thumb: flexion (trial(s) 2, 7) and extension (trial(s) 3, 8)"),
+        "{m}"
+    );
+    assert_eq!(r.issues.len(), 1, "{r}");
+}
+
+/// An anatomical layout: channels 0 and 1 over the flexors, 2 and 3 over the extensors; finger
+/// 0 on channels 0 and 2, finger 1 on 1 and 3, the whole hand on both of its side.
+fn anatomical(swap_finger_1: bool) -> Vec<SynthTrial> {
+    let a = ACTIVE_AMP;
+    let c = 0.3 * ACTIVE_AMP;
+    let mut v = Vec::new();
+    for rep in 1..=2 {
+        v.push(SynthTrial {
+            finger: None,
+            kind: TrialKind::Rest,
+            repetition: rep,
+            amps: [REST_AMP; 4],
+        });
+        let moves = [
+            (
+                Some(0),
+                [a, c, REST_AMP, REST_AMP],
+                [REST_AMP, REST_AMP, a, c],
+            ),
+            (
+                Some(1),
+                [c, a, REST_AMP, REST_AMP],
+                [REST_AMP, REST_AMP, c, a],
+            ),
+            (None, [a, a, REST_AMP, REST_AMP], [REST_AMP, REST_AMP, a, a]),
+        ];
+        for (finger, flex, ext) in moves {
+            let (flex, ext) = if swap_finger_1 && finger == Some(1) {
+                (ext, flex)
+            } else {
+                (flex, ext)
+            };
+            for (kind, amps) in [(TrialKind::Flexion, flex), (TrialKind::Extension, ext)] {
+                v.push(SynthTrial {
+                    finger,
+                    kind,
+                    repetition: rep,
+                    amps,
+                });
+            }
+        }
+    }
+    v
+}
+
+#[test]
+fn a_finger_swapped_against_the_other_movements_is_refused() {
+    let s = session_of(&anatomical(false), 20, |_, _| {});
+    let r = check_gates(&s, &GateConfig::default()).unwrap();
+    assert!(r.passed(), "{r}");
+    assert_eq!(r.patterns.len(), 3, "{r}");
+    assert!(
+        r.patterns.iter().all(|p| p.swap_score.expect("ran") > 1.0),
+        "{r}"
+    );
+    // Finger 1 flexes at the extension cue and extends at the flexion cue: consistent and
+    // distinct, only swapped.
+    let s = session_of(&anatomical(true), 20, |_, _| {});
+    let r = check_gates(&s, &GateConfig::default()).unwrap();
+    let swapped = issues_of(&r, GateKind::SwappedDirections { finger: Some(1) });
+    assert_eq!(swapped, vec![4], "on its first flexion: {r}");
+    assert!(
+        !r.issues
+            .iter()
+            .any(|i| i.kind == GateKind::SwappedDirections { finger: Some(0) }),
+        "the correct finger 0 is not blamed: {r}"
+    );
+    assert!(
+        r.to_string().contains("index: its flexion looks like"),
+        "{r}"
+    );
+}
+
+#[test]
+fn a_finger_moved_in_one_direction_only_is_refused_and_not_ignorable() {
+    // No extension of finger 0 at all.
+    let trials: Vec<SynthTrial> = clean_protocol()
+        .into_iter()
+        .filter(|t| !(t.finger == Some(0) && t.kind == TrialKind::Extension))
+        .collect();
+    let s = session_of(&trials, 21, |_, _| {});
+    let r = check_gates(&s, &GateConfig::default()).unwrap();
+    let one: Vec<_> = r.binding().collect();
+    assert_eq!(one.len(), 1, "{r}");
+    assert_eq!(
+        (one[0].trial_id, one[0].kind),
+        (
+            2,
+            GateKind::OneDirection {
+                finger: 0,
+                missing: TrialKind::Extension
+            }
+        )
+    );
+    assert!(!one[0].kind.can_be_ignored());
+    assert!(
+        one[0]
+            .message
+            .contains("thumb: the session has flexion trials")
+            && one[0].message.contains("no extension trial")
+            && one[0].message.contains("--ignore-gates does not override"),
+        "{r}"
+    );
+    // Every other gate's issue can be ignored.
+    assert!(GateKind::InconsistentPattern.can_be_ignored());
+    // Whole-hand trials count for every finger: with a whole-hand flexion and extension the
+    // thumb has its extension anchor (and the other fingers both).
+    let mut trials = trials;
+    for (kind, amps) in [
+        (
+            TrialKind::Flexion,
+            [ACTIVE_AMP, REST_AMP, ACTIVE_AMP, REST_AMP],
+        ),
+        (
+            TrialKind::Extension,
+            [REST_AMP, ACTIVE_AMP, REST_AMP, ACTIVE_AMP],
+        ),
+    ] {
+        trials.push(SynthTrial {
+            finger: None,
+            kind,
+            repetition: 1,
+            amps,
+        });
+    }
+    let s = session_of(&trials, 21, |_, _| {});
+    let r = check_gates(&s, &GateConfig::default()).unwrap();
+    assert_eq!(r.binding().count(), 0, "{r}");
+    // A whole-hand extension alone gives the fingers never flexed one direction only.
+    trials.truncate(trials.len() - 2);
+    trials.push(SynthTrial {
+        finger: None,
+        kind: TrialKind::Extension,
+        repetition: 1,
+        amps: [REST_AMP, ACTIVE_AMP, REST_AMP, ACTIVE_AMP],
+    });
+    let s = session_of(&trials, 21, |_, _| {});
+    let r = check_gates(&s, &GateConfig::default()).unwrap();
+    let fingers: Vec<usize> = r
+        .binding()
+        .map(|i| match i.kind {
+            GateKind::OneDirection { finger, missing } => {
+                assert_eq!(missing, TrialKind::Flexion);
+                finger
+            }
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    assert_eq!(fingers, vec![2, 3, 4], "{r}");
+}
+
+#[test]
+fn pearson_needs_a_shape() {
+    use decoder::session::pearson;
+    assert_eq!(pearson(&[1.0, 2.0], &[2.0, 1.0]), None, "two channels");
+    assert_eq!(pearson(&[3.0; 4], &[1.0, 2.0, 3.0, 4.0]), None, "flat");
+    let r = pearson(&[1.0, 2.0, 3.0, 4.0], &[10.0, 20.0, 30.0, 40.0]).unwrap();
+    assert!((r - 1.0).abs() < 1e-12);
+    let r = pearson(&[1.0, 2.0, 3.0, 4.0], &[4.0, 3.0, 2.0, 1.0]).unwrap();
+    assert!((r + 1.0).abs() < 1e-12);
 }

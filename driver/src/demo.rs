@@ -199,8 +199,14 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> DemoError + '_ {
 
 /// Record a simulated calibration session (candump `frames.log` + `session.toml`) in `dir`.
 pub fn record_calibration(dir: &Path, seed: u64) -> Result<usize, DemoError> {
+    record_scenario(dir, seed, Scenario::Calibration)
+}
+
+/// [`record_calibration`] with another scripted calibration scenario (e.g.
+/// [`Scenario::CalibrationQuick`], the 0.5 s plateaus of `CalibrationProtocol::quick`).
+pub fn record_scenario(dir: &Path, seed: u64, scenario: Scenario) -> Result<usize, DemoError> {
     std::fs::create_dir_all(dir).map_err(io(dir))?;
-    let run = Scenario::Calibration.build(seed)?;
+    let run = scenario.build(seed)?;
     let signal = AmplifierConfig {
         seed,
         ..AmplifierConfig::default()

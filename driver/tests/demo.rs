@@ -59,3 +59,118 @@ fn demo_calibrates_trains_and_tracks_a_sine() {
     assert_eq!(saved.rest_rms_uv().map(<[f64]>::len), Some(12));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Issue 32 item 3: the quality gates refuse none of the simulator's calibration sessions (the
+/// demo's full protocol and the quick one, two seeds each), and they do refuse a full session
+/// whose index flexion and extension are swapped, or made the same movement, or one of whose
+/// index flexions is an extension. Prints the pattern figures of each session.
+#[test]
+fn the_simulated_calibrations_pass_the_gates_and_a_swapped_finger_does_not() {
+    use decoder::session::{check_gates, GateConfig, GateKind, Session, TrialKind};
+    use driver::demo::record_scenario;
+    use hand_model::Scenario;
+
+    let root = std::env::temp_dir().join(format!("handstack-demo-gates-{}", std::process::id()));
+    let mut full = None;
+    for (scenario, seed) in [
+        (Scenario::Calibration, 1),
+        (Scenario::Calibration, 2),
+        (Scenario::CalibrationQuick, 1),
+        (Scenario::CalibrationQuick, 3),
+    ] {
+        let dir = root.join(format!("{}-{seed}", scenario.name()));
+        record_scenario(&dir, seed, scenario).expect("simulated calibration");
+        let s = Session::open(&dir).expect("the session opens");
+        let r = check_gates(&s, &GateConfig::default()).expect("gates run");
+        println!("{} seed {seed}:\n{r}", scenario.name());
+        assert!(r.passed(), "{} seed {seed} refused:\n{r}", scenario.name());
+        assert!(!r.patterns.is_empty(), "the pattern gates ran");
+        if full.is_none() {
+            full = Some(s);
+        }
+    }
+    let s = full.expect("the full session");
+    let index = |t: &decoder::session::Trial, kind| t.finger == Some(1) && t.kind == kind;
+    let refused = |meta: decoder::session::SessionMeta, what: &str| {
+        let bad = Session::from_parts("edited".into(), meta, s.recording.clone()).expect("parts");
+        let r = check_gates(&bad, &GateConfig::default()).expect("gates run");
+        println!("{what}:\n{r}");
+        assert!(!r.passed(), "{what} passed the gates:\n{r}");
+        r
+    };
+
+    // Every index flexion labelled extension and the reverse: consistent, distinct, inverted.
+    let mut meta = s.meta.clone();
+    for t in &mut meta.trials {
+        if t.finger == Some(1) && t.kind != TrialKind::Rest {
+            t.kind = if t.kind == TrialKind::Flexion {
+                TrialKind::Extension
+            } else {
+                TrialKind::Flexion
+            };
+        }
+    }
+    let r = refused(meta, "index swapped");
+    assert!(
+        r.issues
+            .iter()
+            .any(|i| i.kind == GateKind::SwappedDirections { finger: Some(1) }),
+        "{r}"
+    );
+    assert!(
+        r.issues
+            .iter()
+            .all(|i| matches!(i.kind, GateKind::SwappedDirections { .. })),
+        "only the swap: {r}"
+    );
+
+    // The patient extends at every flexion cue: the extensions' samples over the flexions'.
+    let ch = s.recording.channels;
+    let range = |t: &decoder::session::Trial| s.recording.range_of(t.start_us, t.end_us);
+    let flex: Vec<_> = s
+        .meta
+        .trials
+        .iter()
+        .filter(|t| index(t, TrialKind::Flexion))
+        .collect();
+    let ext: Vec<_> = s
+        .meta
+        .trials
+        .iter()
+        .filter(|t| index(t, TrialKind::Extension))
+        .collect();
+    let mut rec = s.recording.clone();
+    for (f, e) in flex.iter().zip(&ext) {
+        let (f, e) = (range(f), range(e));
+        let n = f.len().min(e.len()) * ch;
+        rec.samples[f.start * ch..f.start * ch + n]
+            .copy_from_slice(&s.recording.samples[e.start * ch..e.start * ch + n]);
+    }
+    let same = Session::from_parts("edited".into(), s.meta.clone(), rec).expect("parts");
+    let r = check_gates(&same, &GateConfig::default()).expect("gates run");
+    println!("index extends at every flexion cue:\n{r}");
+    assert!(
+        r.issues
+            .iter()
+            .any(|i| i.kind == GateKind::FlexionLikeExtension { finger: Some(1) }),
+        "{r}"
+    );
+
+    // Once: the second index flexion holds an extension (its samples).
+    let mut rec = s.recording.clone();
+    let (f, e) = (range(flex[1]), range(ext[1]));
+    let n = f.len().min(e.len()) * ch;
+    rec.samples[f.start * ch..f.start * ch + n]
+        .copy_from_slice(&s.recording.samples[e.start * ch..e.start * ch + n]);
+    let id = flex[1].id;
+    let once = Session::from_parts("edited".into(), s.meta.clone(), rec).expect("parts");
+    let r = check_gates(&once, &GateConfig::default()).expect("gates run");
+    println!("index extends at one flexion cue:\n{r}");
+    assert!(
+        r.issues
+            .iter()
+            .any(|i| i.trial_id == id && i.kind == GateKind::InconsistentPattern),
+        "{r}"
+    );
+    std::fs::remove_dir_all(&root).unwrap();
+}

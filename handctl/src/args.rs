@@ -271,9 +271,17 @@ pub struct TrainingOpts {
     /// Upper bound on training epochs (early stopping on held-out windows may end sooner).
     #[arg(long, default_value_t = 200)]
     pub epochs: usize,
-    /// Train even when the quality gates find trials to redo.
+    /// Train even when the quality gates find trials to redo (except a finger moved in one
+    /// direction only: see --allow-one-direction).
     #[arg(long)]
     pub ignore_gates: bool,
+    /// Train even when the session moves a finger in one direction only (flexion without
+    /// extension or the reverse), which --ignore-gates does not override: that finger is trained
+    /// with one anchor and is never driven the other way. Only for research recordings that hold
+    /// one direction (e.g. an EMG and force recording of one contraction), never for a
+    /// patient's model.
+    #[arg(long)]
+    pub allow_one_direction: bool,
     /// Validation split for early stopping: trial-tail (the end of every trial, so every trial
     /// also trains; works with a one-repetition calibration), trial (whole trials held out),
     /// window or none [default: trial-tail; trial with --plain, as the paper's training was

@@ -58,6 +58,14 @@ pub enum CliError {
     /// The quality gates found trials to redo.
     #[error("the session failed its quality gates ({0} trial problem(s) above); redo those trials, or pass --ignore-gates")]
     Gates(usize),
+    /// The session moves some finger in one direction only; `--ignore-gates` does not override it.
+    #[error(
+        "the session moves {0} finger(s) in one direction only (above): such a finger would be \
+         trained with one anchor and never driven the other way; record the missing direction \
+         (--ignore-gates does not override this; --allow-one-direction does, for a research \
+         recording that holds one direction only, never for a patient's model)"
+    )]
+    OneDirection(usize),
     /// A verification could not run.
     #[error("verification: {0}")]
     Verify(#[from] decoder::model::verify::VerifyError),
@@ -99,7 +107,7 @@ impl CliError {
     /// verification, 5 for a deploy to another patient not confirmed, 1 otherwise.
     pub fn exit_code(&self) -> u8 {
         match self {
-            CliError::Gates(_) => 3,
+            CliError::Gates(_) | CliError::OneDirection(_) => 3,
             CliError::Refused { .. } => 4,
             CliError::Unconfirmed { .. } => 5,
             _ => 1,

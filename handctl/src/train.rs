@@ -2,7 +2,9 @@
 
 use decoder::model::provenance::{describe_provenance, utc_now};
 use decoder::model::{train, Dataset, ModelKind, ModelSpec, Provenance, TrainConfig, TrainedModel};
-use decoder::session::{check_gates, GateConfig, LabelledWindows, Session, WindowOptions};
+use decoder::session::{
+    check_gates, GateConfig, GateReport, LabelledWindows, Session, WindowOptions,
+};
 
 use super::args::{CheckArgs, TrainArgs, TrainingOpts};
 use super::error::CliError;
@@ -20,11 +22,30 @@ pub(super) fn gate(session: &Session, opts: &TrainingOpts) -> Result<Vec<String>
         return Ok(Vec::new());
     }
     eprint!("{}: quality gates:\n{report}", session.name.display());
+    overrule(&report, opts)
+}
+
+/// Whether training may go on despite the gates' `report` (which did not pass): only with
+/// `--ignore-gates`, and a finger moved in one direction only also needs
+/// `--allow-one-direction` (see [`decoder::session::GateKind::can_be_ignored`]). Returns the
+/// findings bypassed, for the model file's provenance.
+pub(crate) fn overrule(report: &GateReport, opts: &TrainingOpts) -> Result<Vec<String>, CliError> {
+    let binding = report.binding().count();
+    if binding > 0 && !opts.allow_one_direction {
+        return Err(CliError::OneDirection(binding));
+    }
+    if binding > 0 {
+        eprintln!("--allow-one-direction: {binding} finger(s) trained in one direction only");
+    }
+    if report.issues.len() == binding {
+        // Nothing `--ignore-gates` bypassed (the file records no gate bypass).
+        return Ok(Vec::new());
+    }
     if opts.ignore_gates {
         eprintln!("--ignore-gates: training anyway (the model file records the findings bypassed)");
         Ok(report.issues.iter().map(|i| i.message.clone()).collect())
     } else {
-        Err(CliError::Gates(report.issues.len()))
+        Err(CliError::Gates(report.issues.len() - binding))
     }
 }
 

@@ -251,14 +251,17 @@ fn import_an_npy_recording_with_a_label_table_and_train_on_it() {
     std::fs::create_dir_all(&dir).unwrap();
     // Four channels; rest, then flexion and extension of the index finger (channels 0 and 1)
     // and the whole hand (all channels), two repetitions each, 2 s per trial.
-    let plan: [(&str, &str, [f64; 4]); 4] = [
+    let plan: [(&str, &str, [f64; 4]); 5] = [
         ("all", "rest", [5.0; 4]),
         ("index", "flexion", [120.0, 30.0, 5.0, 5.0]),
         ("1", "extension", [30.0, 120.0, 5.0, 5.0]),
         ("all", "flexion", [120.0, 30.0, 120.0, 30.0]),
+        ("all", "extension", [30.0, 120.0, 30.0, 120.0]),
     ];
     let mut samples = Vec::new();
     let mut labels = String::from("finger,kind,repetition,start_sample,end_sample\n");
+    // The same recording labelled without the whole hand's extensions.
+    let mut flexion_only = labels.clone();
     let mut rng = 7u64;
     for rep in 1..=2 {
         for (finger, kind, amps) in plan {
@@ -268,31 +271,62 @@ fn import_an_npy_recording_with_a_label_table_and_train_on_it() {
                     samples.push((a * noise(&mut rng)).round());
                 }
             }
-            labels.push_str(&format!("{finger},{kind},{rep},{start},{}\n", start + 2000));
+            let row = format!("{finger},{kind},{rep},{start},{}\n", start + 2000);
+            if (finger, kind) != ("all", "extension") {
+                flexion_only.push_str(&row);
+            }
+            labels.push_str(&row);
         }
     }
     let npy = dir.join("emg.npy");
     decoder::session::write_npy_f64(&npy, samples.len() / 4, 4, &samples).unwrap();
     std::fs::write(dir.join("labels.csv"), labels).unwrap();
-    let session = dir.join("session");
-    let out = handctl(&[
-        "import",
-        "--samples",
-        s(&npy),
-        "--labels",
-        s(&dir.join("labels.csv")),
-        "--channels",
-        "4",
-        "--rows-are-recordings",
-        "-o",
-        s(&session),
-    ]);
-    assert!(out.status.success(), "{}", text(&out.stderr));
-    assert!(
-        text(&out.stdout).contains("8 trials"),
-        "{}",
+    std::fs::write(dir.join("flexion_only.csv"), flexion_only).unwrap();
+    let import = |labels: &str, session: &Path| {
+        let out = handctl(&[
+            "import",
+            "--samples",
+            s(&npy),
+            "--labels",
+            s(&dir.join(labels)),
+            "--channels",
+            "4",
+            "--rows-are-recordings",
+            "-o",
+            s(session),
+        ]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
         text(&out.stdout)
+    };
+    // Issue 32 item 3: thumb, middle, ring and pinky would only ever be flexed (by the whole
+    // hand): check refuses the session, and train refuses it even with --ignore-gates.
+    let partial = dir.join("partial");
+    assert!(import("flexion_only.csv", &partial).contains("8 trials"));
+    let out = handctl(&["check", s(&partial)]);
+    assert_eq!(out.status.code(), Some(3), "{}", text(&out.stdout));
+    let o = text(&out.stdout);
+    assert!(
+        o.contains("thumb: the session has flexion trials") && o.contains("one anchor"),
+        "{o}"
     );
+    let out = handctl(&[
+        "train",
+        s(&partial),
+        "-o",
+        s(&dir.join("no.hsm")),
+        "--ignore-gates",
+    ]);
+    assert_eq!(out.status.code(), Some(3), "{}", text(&out.stderr));
+    let e = text(&out.stderr);
+    assert!(
+        e.contains("moves 4 finger(s) in one direction only")
+            && e.contains("--allow-one-direction"),
+        "{e}"
+    );
+    assert!(!dir.join("no.hsm").exists());
+    let session = dir.join("session");
+    let o = import("labels.csv", &session);
+    assert!(o.contains("10 trials"), "{o}");
     let out = handctl(&["check", s(&session)]);
     assert!(
         out.status.success(),

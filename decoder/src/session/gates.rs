@@ -12,8 +12,14 @@
 //!   windows) is below `min_contrast` times the mean of the rest trials.
 //! * **Weak repetition**: a trial's mean RMS is below `min_repeat_ratio` times the strongest
 //!   repetition of the same finger and kind.
+//! * **Too few windows**: a trial gives fewer than [`MIN_WINDOWS_PER_TRIAL`] feature windows.
+//! * **Patterns and directions** (the channel profile of each movement, not only its amplitude):
+//!   repetitions of one movement that do not share a pattern, a finger whose flexion and
+//!   extension look the same or swapped against the other movements, and a finger moved in one
+//!   direction only; see [`super::patterns`].
 
 use super::error::SessionError;
+use super::patterns::{pattern_gates, PatternFigures, PatternInput};
 use super::trial::{Trial, TrialKind};
 use super::windows::WindowOptions;
 use super::Session;
@@ -32,7 +38,37 @@ pub struct GateConfig {
     pub min_contrast: f64,
     /// Minimum ratio of a trial's mean RMS to its strongest repetition's.
     pub min_repeat_ratio: f64,
+    /// Minimum Pearson r of a repetition's channel profile against the mean of the other
+    /// repetitions of the same movement.
+    pub min_pattern_similarity: f64,
+    /// Maximum Pearson r of a finger's mean flexion profile against its mean extension profile.
+    pub max_flex_ext_similarity: f64,
 }
+
+/// Fewest feature windows a trial must give. The gates and the training average a trial over
+/// its windows: one window (200 ms) is a single burst of motor-unit activity, whose RMS varies
+/// by tens of percent from one window to the next, and a trial that short is a mis-timed cue
+/// rather than a hold. Five windows at the 50 ms hop span 400 ms of hold, enough to average
+/// that out; the shortest hold anywhere in the stack (the simulator's quick protocol, 0.5 s)
+/// gives 7, `handctl calibrate`'s shortest (1 s) gives 17 and a 3DC recording about 85.
+pub const MIN_WINDOWS_PER_TRIAL: usize = 5;
+
+/// Default of [`GateConfig::min_pattern_similarity`]. Measured (Pearson r of a repetition against
+/// the mean of the others): the six 3DC sessions 0.69 (P4 train, a varying power grip) to 1.00,
+/// the simulator's sessions 1.00; a repetition of the opposite movement scores about the
+/// session's flexion-extension r (-0.56 to 0.32 on five 3DC sessions, -0.29 in the simulator).
+/// 0.5 keeps 0.19 below the lowest honest figure and still catches the opposite movement
+/// wherever flexion and extension differ (not on P4 train, whose two grips correlate at 0.87).
+pub const MIN_PATTERN_SIMILARITY: f64 = 0.5;
+
+/// Default of [`GateConfig::max_flex_ext_similarity`]. Measured (mean flexion against mean
+/// extension profile): the six 3DC sessions -0.56 to 0.87 (P4 train), the simulator's -0.99 to
+/// -0.28. The same movement at both cues: 1.00 with the flexions' samples copied over the
+/// extensions' (3DC and simulator); a patient's real second attempt at one movement would score
+/// like one mean of repetitions against another, not measured here (single repetitions against
+/// the mean of the others: 0.94 to 1.00 but for 0.69 and 0.72). 0.95 lies between the honest
+/// 0.87 and those; a patient as variable as P4's power grip could slip under it.
+pub const MAX_FLEX_EXT_SIMILARITY: f64 = 0.95;
 
 impl Default for GateConfig {
     fn default() -> Self {
@@ -42,6 +78,8 @@ impl Default for GateConfig {
             noisy_ratio: 5.0,
             min_contrast: 1.5,
             min_repeat_ratio: 0.5,
+            min_pattern_similarity: MIN_PATTERN_SIMILARITY,
+            max_flex_ext_similarity: MAX_FLEX_EXT_SIMILARITY,
         }
     }
 }
@@ -70,6 +108,39 @@ pub enum GateKind {
     WeakRepetition,
     /// The trial yields no window at all.
     NoWindows,
+    /// The trial yields fewer than [`MIN_WINDOWS_PER_TRIAL`] windows.
+    FewWindows {
+        /// The windows it gave.
+        windows: usize,
+    },
+    /// The trial's channel pattern is unlike the other repetitions of its movement.
+    InconsistentPattern,
+    /// A finger's (or the whole hand's, `None`) flexion and extension show the same pattern.
+    FlexionLikeExtension {
+        /// The finger, `None` for the whole hand.
+        finger: Option<usize>,
+    },
+    /// A finger's flexion and extension look swapped against the other movements.
+    SwappedDirections {
+        /// The finger, `None` for the whole hand.
+        finger: Option<usize>,
+    },
+    /// The session moves a finger in one direction only: it would be trained with one anchor.
+    /// Not overridden by `--ignore-gates`.
+    OneDirection {
+        /// The finger.
+        finger: usize,
+        /// The kind the session lacks for it.
+        missing: TrialKind,
+    },
+}
+
+impl GateKind {
+    /// False for problems no `--ignore-gates` may override: a finger moved in one direction only
+    /// is never trained.
+    pub fn can_be_ignored(&self) -> bool {
+        !matches!(self, GateKind::OneDirection { .. })
+    }
 }
 
 /// One problem found.
@@ -90,12 +161,19 @@ pub struct GateReport {
     pub issues: Vec<GateIssue>,
     /// Gates that could not run and why (e.g. no rest trial to compare against).
     pub notes: Vec<String>,
+    /// What the pattern gates measured, per finger (and the whole hand).
+    pub patterns: Vec<PatternFigures>,
 }
 
 impl GateReport {
     /// True when no gate fired.
     pub fn passed(&self) -> bool {
         self.issues.is_empty()
+    }
+
+    /// The issues that `--ignore-gates` may not override (see [`GateKind::can_be_ignored`]).
+    pub fn binding(&self) -> impl Iterator<Item = &GateIssue> {
+        self.issues.iter().filter(|i| !i.kind.can_be_ignored())
     }
 }
 
@@ -106,6 +184,9 @@ impl std::fmt::Display for GateReport {
         }
         for n in &self.notes {
             writeln!(f, "note: {n}")?;
+        }
+        for p in &self.patterns {
+            writeln!(f, "{p}")?;
         }
         if self.passed() {
             writeln!(f, "all quality gates passed")?;
@@ -136,35 +217,44 @@ pub fn noisy_against_others(levels: &[f64], channel: usize, ratio: f64) -> Optio
     (own > ratio * median).then_some(median)
 }
 
-/// The noisy-electrode gate: `rms[trial][channel]` is the mean windowed RMS, `count[trial]`
-/// its windows.
-fn noisy_at_rest(
-    rms: &[Vec<f64>],
-    count: &[usize],
-    trials: &[Trial],
-    config: &GateConfig,
-    report: &mut GateReport,
-) {
+/// The rest level per channel: the mean windowed RMS over every window of the rest trials
+/// (`rms[trial][channel]` is a trial's mean windowed RMS, `count[trial]` its windows); `None`
+/// without a rest window.
+fn rest_level(rms: &[Vec<f64>], count: &[usize], trials: &[Trial]) -> Option<Vec<f64>> {
     let rest: Vec<usize> = (0..trials.len())
         .filter(|&i| trials[i].kind == TrialKind::Rest && count[i] > 0)
         .collect();
-    let (Some(&first), Some(ch)) = (rest.first(), rms.first().map(Vec::len)) else {
+    let ch = rms.first().map(Vec::len)?;
+    let windows: usize = rest.iter().map(|&i| count[i]).sum();
+    (windows > 0).then(|| {
+        (0..ch)
+            .map(|c| {
+                rest.iter()
+                    .map(|&i| rms[i][c] * count[i] as f64)
+                    .sum::<f64>()
+                    / windows as f64
+            })
+            .collect()
+    })
+}
+
+/// The noisy-electrode gate on the rest level per channel, reported on the first rest trial.
+fn noisy_at_rest(
+    level: Option<&[f64]>,
+    trials: &[Trial],
+    count: &[usize],
+    config: &GateConfig,
+    report: &mut GateReport,
+) {
+    let first = (0..trials.len()).find(|&i| trials[i].kind == TrialKind::Rest && count[i] > 0);
+    let (Some(first), Some(level)) = (first, level) else {
         return;
     };
-    if ch < 2 {
+    if level.len() < 2 {
         return;
     }
-    let windows: usize = rest.iter().map(|&i| count[i]).sum();
-    let level: Vec<f64> = (0..ch)
-        .map(|c| {
-            rest.iter()
-                .map(|&i| rms[i][c] * count[i] as f64)
-                .sum::<f64>()
-                / windows as f64
-        })
-        .collect();
     for (c, &own) in level.iter().enumerate() {
-        if let Some(median) = noisy_against_others(&level, c, config.noisy_ratio) {
+        if let Some(median) = noisy_against_others(level, c, config.noisy_ratio) {
             report.issues.push(GateIssue {
                 trial_id: trials[first].id,
                 kind: GateKind::Noisy { channel: c },
@@ -186,6 +276,7 @@ pub fn check_gates(session: &Session, config: &GateConfig) -> Result<GateReport,
     let windows = session.windows(&WindowOptions::default())?;
     let trials = &session.meta.trials;
     let mut report = GateReport::default();
+    let chain = &session.meta.chain;
     let (rms, count) = trial_rms(&windows, session.recording.channels, trials.len());
     let strength: Vec<f64> = rms
         .iter()
@@ -200,11 +291,41 @@ pub fn check_gates(session: &Session, config: &GateConfig) -> Result<GateReport,
             });
             continue;
         }
+        if count[ti] < MIN_WINDOWS_PER_TRIAL {
+            report.issues.push(GateIssue {
+                trial_id: t.id,
+                kind: GateKind::FewWindows { windows: count[ti] },
+                message: format!(
+                    "{t}: only {} feature window(s) ({:.2} s long; a trial needs at least \
+                     {MIN_WINDOWS_PER_TRIAL}, {} ms of hold at the {} ms window and {} ms \
+                     step{}); record it again, holding the contraction longer",
+                    count[ti],
+                    t.end_us.saturating_sub(t.start_us) as f64 * 1e-6,
+                    chain.window_ms + chain.step_ms * (MIN_WINDOWS_PER_TRIAL - 1) as f64,
+                    chain.window_ms,
+                    chain.step_ms,
+                    if session.meta.onset_skip_ms > 0.0 {
+                        format!(", after the {} ms onset skip", session.meta.onset_skip_ms)
+                    } else {
+                        String::new()
+                    }
+                ),
+            });
+        }
         channel_gates(session, config, t, &rms[ti], &mut report);
     }
-    noisy_at_rest(&rms, &count, trials, config, &mut report);
+    let usable: Vec<bool> = count.iter().map(|&n| n >= MIN_WINDOWS_PER_TRIAL).collect();
+    let rest = rest_level(&rms, &count, trials);
+    noisy_at_rest(rest.as_deref(), trials, &count, config, &mut report);
     contrast_gate(trials, &strength, &count, config, &mut report);
     repeat_gate(trials, &strength, &count, config, &mut report);
+    let input = PatternInput {
+        trials,
+        rms: &rms,
+        usable: &usable,
+        rest: rest.as_deref(),
+    };
+    pattern_gates(&input, config, &mut report);
     report.issues.sort_by_key(|i| i.trial_id);
     Ok(report)
 }

@@ -17,6 +17,7 @@ mod import;
 mod load;
 mod meta;
 mod npy;
+mod patterns;
 mod recording;
 mod reference;
 mod rest_level;
@@ -30,12 +31,18 @@ use std::path::{Path, PathBuf};
 
 pub use columns::{SampleTable, SplitColumns};
 pub use error::SessionError;
-pub use gates::{check_gates, noisy_against_others, GateConfig, GateIssue, GateKind, GateReport};
+pub use gates::{
+    check_gates, noisy_against_others, GateConfig, GateIssue, GateKind, GateReport,
+    MAX_FLEX_EXT_SIMILARITY, MIN_PATTERN_SIMILARITY, MIN_WINDOWS_PER_TRIAL,
+};
 pub use import::{import_3dc, load_3dc, parse_session_spec, SessionSpec, Split};
 pub use meta::{
     RecordingFormat, RecordingSpec, Segment, SessionMeta, FORMAT_VERSION, MAX_TIME_US, META_FILE,
 };
 pub use npy::{npy_f64_bytes, write_npy_f64};
+pub use patterns::{
+    pearson, PatternFigures, MIN_PATTERN_CHANNELS, MIN_REFERENCE_MOVEMENTS, SWAP_MARGIN,
+};
 pub use recording::Recording;
 pub use reference::{Reference, ReferenceSpec, REFERENCE_FILE};
 pub use stream::StreamWindows;

@@ -184,7 +184,13 @@ fn the_cued_patient_is_calibrated_in_memory_the_weak_trial_repeated_and_a_ctrl_c
         done.reactions_us
     );
     let report = check_gates(&session, &GateConfig::default()).expect("gates run");
+    println!("the calibrated session's gates:\n{report}");
     assert!(report.passed(), "{report}");
+    assert_eq!(
+        report.patterns.len(),
+        2,
+        "index and the whole hand: {report}"
+    );
     // Independently: the weak attempt in its place fails the calibration's repetition gate.
     let mut meta = session.meta.clone();
     meta.trials[usize::from(WEAK)] = weak.trial;
@@ -209,6 +215,7 @@ fn train_and_summarize(dir: &Path) {
         seed: 0,
         epochs: 200,
         ignore_gates: false,
+        allow_one_direction: false,
         validation: None,
     };
     let trained = super::training::train_session(

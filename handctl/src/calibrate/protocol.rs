@@ -11,7 +11,7 @@
 //! relax_s = 5.0            # relax between trials
 //! rest_s = 5.0             # length of the rest trial's hold (default hold_s)
 //! fingers = ["thumb", "index", "middle", "ring", "pinky", "all"]
-//! kinds = ["flexion", "extension"]
+//! kinds = ["flexion", "extension"]   # both, in this order or the other (one alone is refused)
 //! max_attempts = 3         # a trial failing its check this often fails the calibration
 //! ```
 
@@ -243,6 +243,23 @@ fn build_movements(
             return Err(("kinds", format!("{k:?} is named twice")));
         }
         ks.push(kind);
+    }
+    if let [only] = ks[..] {
+        let other = if only == TrialKind::Flexion {
+            TrialKind::Extension
+        } else {
+            TrialKind::Flexion
+        };
+        return Err((
+            "kinds",
+            format!(
+                "names {} alone: every finger would be trained with one anchor and never \
+                 driven the other way; name both, [\"flexion\", \"extension\"] (the quality \
+                 gates refuse a session without {} too)",
+                only.name(),
+                other.name()
+            ),
+        ));
     }
     debug_assert!(fs.iter().flatten().all(|&f| f < N_FINGERS));
     Ok(fs

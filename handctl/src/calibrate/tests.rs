@@ -35,6 +35,14 @@ fn bad_protocols_are_refused_naming_the_key_and_line() {
     assert!(short.contains("hold_s"), "{short}");
     let kind = invalid("kinds = [\"rest\"]");
     assert!(kind.contains("kinds"), "{kind}");
+    // One direction alone: every finger would have one anchor (issue 32 item 3).
+    let one = invalid("kinds = [\"flexion\"]");
+    assert!(
+        one.contains("kinds") && one.contains("one anchor") && one.contains("extension"),
+        "{one}"
+    );
+    let one = invalid("kinds = [\"Extension\"]");
+    assert!(one.contains("extension alone"), "{one}");
     let twice = invalid("fingers = [\"all\", \"ALL\"]");
     assert!(twice.contains("twice"), "{twice}");
     let typed = invalid("hold_s = \"5\"");

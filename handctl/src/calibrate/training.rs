@@ -44,11 +44,15 @@ pub fn train_session(
     let gates = check_gates(&session, &GateConfig::default())?;
     if !gates.passed() {
         eprint!("{}: quality gates:\n{gates}", dir.display());
-        if !opts.ignore_gates {
-            return Err(CliError::Gates(gates.issues.len()));
-        }
+        crate::train::overrule(&gates, opts)?;
     }
-    let bypassed = gates.issues.iter().map(|i| i.message.clone()).collect();
+    // The findings `--ignore-gates` went past (a one-direction finger allowed alone is not a
+    // gate bypass).
+    let bypassed = if opts.ignore_gates && !gates.passed() {
+        gates.issues.iter().map(|i| i.message.clone()).collect()
+    } else {
+        Vec::new()
+    };
     let origin = provenance(
         patient,
         crate::train::session_id(&dir.display().to_string()),
