@@ -222,8 +222,11 @@ fn front_end(channels: usize, rate: f64, window_len: usize, step_len: usize) -> 
         s(&samples),
         s(&labels)
     )));
+    // A synthetic research recording: flexion and an angle, no extension trial of every
+    // finger, so the one-direction refusal is overridden as for a research recording.
     ok(run(&format!(
-        "train {session} -o {model} --model ln --epochs 30 --validation none --seed 2"
+        "train {session} -o {model} --model ln --epochs 30 --validation none --seed 2 \
+         --allow-one-direction"
     )));
     let json = ok(run(&format!(
         "decode {session} --model {model} -o {decoded} --finger 1 --json"
@@ -325,7 +328,8 @@ fn decode_without_a_reference_and_the_errors() {
     // Two epochs make a model fast, not a monotonic one: this test is about decode's errors, so
     // the verification's refusal is overridden (and the file records it as forced).
     ok(run(&format!(
-        "train {session} -o {model} --model ln --epochs 2 --validation none --force"
+        "train {session} -o {model} --model ln --epochs 2 --validation none --force \
+         --allow-one-direction"
     )));
     let decode = |extra: &str| run(&format!("decode {session} --model {model} {extra}"));
     let out = ok(decode(&format!("-o {decoded}")));
