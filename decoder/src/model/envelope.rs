@@ -53,6 +53,8 @@ pub struct Envelope {
     max: Vec<f64>,
     /// Whether input `j` scales with the square of the signal (VAR).
     squared: Vec<bool>,
+    /// The index of RMS among a channel's features.
+    rms: usize,
 }
 
 /// The index of VAR among a channel's features.
@@ -86,7 +88,11 @@ impl Envelope {
         let squared = (0..max.len())
             .map(|j| j % FEATURES_PER_CHANNEL == var)
             .collect();
-        Ok(Self { max, squared })
+        let rms = FEATURE_NAMES
+            .iter()
+            .position(|n| *n == "RMS")
+            .expect("RMS is one of the chain's features");
+        Ok(Self { max, squared, rms })
     }
 
     /// The envelope of `rows` (raw feature vectors of `n` features each): per feature, the
@@ -149,10 +155,7 @@ impl Envelope {
     /// (see the module docs and [`PLAUSIBLE_SPREAD`]). No allocation.
     #[inline]
     pub fn implausible(&self, x: &[f64]) -> bool {
-        let rms = FEATURE_NAMES
-            .iter()
-            .position(|n| *n == "RMS")
-            .expect("RMS is one of the chain's features");
+        let rms = self.rms;
         let channels = (x.len() / FEATURES_PER_CHANNEL).min(MAX_CHANNELS);
         let mut excess = [0.0f64; MAX_CHANNELS];
         for (c, e) in excess.iter_mut().enumerate().take(channels) {
@@ -248,6 +251,19 @@ mod tests {
         assert!(out[..FEATURES_PER_CHANNEL]
             .iter()
             .all(|o| *o <= 0.05 + 1e-12));
+    }
+
+    #[test]
+    fn one_channel_beyond_is_implausible_every_channel_beyond_is_not() {
+        let e = unit(4);
+        let mut x = vec![0.6; 4 * FEATURES_PER_CHANNEL];
+        assert!(!e.implausible(&x), "inside");
+        let all: Vec<f64> = x.iter().map(|v| v * 3.0).collect();
+        assert!(!e.implausible(&all), "a stronger contraction on every channel");
+        for v in &mut x[FEATURES_PER_CHANNEL..2 * FEATURES_PER_CHANNEL] {
+            *v *= 10.0;
+        }
+        assert!(e.implausible(&x), "one electrode at ten times its level");
     }
 
     #[test]

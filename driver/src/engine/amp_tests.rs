@@ -1,12 +1,10 @@
 //! Issue 32 item 8: the amplifier's own status decides whether its samples may drive the hand.
 
-use decoder::dsp::ChainConfig;
-use decoder::model::{AnyModel, ModelKind, ModelSpec, Normalizer, TrainedModel, TrainingSummary};
 use hand_dbc::e2e::E2eProtector;
 use hand_dbc::messages::{AmpGain, AmpSampleRate, AmpState, EmgStatus};
 
 use super::rx::{amp_problem, AmpProblem, AMP_STATUS_SILENCE_US};
-use super::{Engine, EngineSettings};
+use super::Engine;
 use crate::safety::Fault;
 
 fn status(state: AmpState, rate: AmpSampleRate, faults: u8) -> EmgStatus {
@@ -39,23 +37,7 @@ fn init_another_rate_and_a_fault_bit_are_named_an_overrun_is_not() {
 }
 
 fn engine() -> Engine {
-    let chain = ChainConfig::default();
-    let n_in = 8 * chain.channels;
-    let spec = ModelSpec::default();
-    let model = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, 1).expect("model");
-    let norm = Normalizer::from_scales(vec![100.0; n_in]).expect("normalizer");
-    let summary = TrainingSummary::untrained(ModelKind::ResDd);
-    let predictor = TrainedModel::new(model, spec, norm, chain.clone(), summary)
-        .expect("trained model")
-        .predictor();
-    let mut e = Engine::new(
-        &chain.validate().expect("chain"),
-        predictor,
-        EngineSettings::default(),
-        0,
-    );
-    e.validated(0);
-    e
+    super::test_support::validated_engine(1)
 }
 
 #[test]

@@ -20,6 +20,8 @@ mod epoch;
 mod faults;
 mod rx;
 mod swap;
+#[cfg(test)]
+mod test_support;
 mod tx;
 
 pub use epoch::{fresh_epoch, fresh_epochs};

@@ -183,24 +183,13 @@ impl Command {
 #[cfg(test)]
 mod tests {
     use decoder::dsp::ChainConfig;
-    use decoder::model::{
-        AnyModel, ModelKind, ModelSpec, Normalizer, TrainedModel, TrainingSummary,
-    };
 
     use super::*;
     use crate::engine::EngineSettings;
     use crate::safety::DaemonState;
 
     fn predictor() -> Predictor {
-        let chain = ChainConfig::default();
-        let n_in = 8 * chain.channels;
-        let spec = ModelSpec::default();
-        let model = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, 3).expect("model");
-        let norm = Normalizer::from_scales(vec![100.0; n_in]).expect("normalizer");
-        let summary = TrainingSummary::untrained(ModelKind::ResDd);
-        TrainedModel::new(model, spec, norm, chain, summary)
-            .expect("trained model")
-            .predictor()
+        crate::engine::test_support::random_predictor(3)
     }
 
     #[test]

@@ -173,10 +173,6 @@ impl Engine {
 
 #[cfg(test)]
 mod tests {
-    use decoder::dsp::ChainConfig;
-    use decoder::model::{
-        AnyModel, ModelKind, ModelSpec, Normalizer, TrainedModel, TrainingSummary,
-    };
     use hand_dbc::messages::HandDiag;
     use hand_dbc::CanFrame;
 
@@ -184,19 +180,7 @@ mod tests {
 
     /// An engine in READY with a random model: no EMG ever comes, so the model never runs.
     fn engine() -> Engine {
-        let chain = ChainConfig::default();
-        let n_in = 8 * chain.channels;
-        let spec = ModelSpec::default();
-        let model = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, 1).expect("model");
-        let norm = Normalizer::from_scales(vec![100.0; n_in]).expect("normalizer");
-        let summary = TrainingSummary::untrained(ModelKind::ResDd);
-        let predictor = TrainedModel::new(model, spec, norm, chain.clone(), summary)
-            .expect("trained model")
-            .predictor();
-        let chain = chain.validate().expect("chain");
-        let mut e = Engine::new(&chain, predictor, EngineSettings::default(), 0);
-        e.validated(0);
-        e
+        crate::engine::test_support::validated_engine(1)
     }
 
     fn diag(frames: &[CanFrame]) -> HandDiag {
