@@ -259,7 +259,10 @@ mod tests {
         let mut x = vec![0.6; 4 * FEATURES_PER_CHANNEL];
         assert!(!e.implausible(&x), "inside");
         let all: Vec<f64> = x.iter().map(|v| v * 3.0).collect();
-        assert!(!e.implausible(&all), "a stronger contraction on every channel");
+        assert!(
+            !e.implausible(&all),
+            "a stronger contraction on every channel"
+        );
         for v in &mut x[FEATURES_PER_CHANNEL..2 * FEATURES_PER_CHANNEL] {
             *v *= 10.0;
         }
