@@ -36,7 +36,7 @@
 //! held still for the ~1.3 s the restart takes, and every restart is in the journal.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{sync_channel, Receiver, RecvTimeoutError, SyncSender};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::Duration;
@@ -307,11 +307,29 @@ pub fn save(path: &Path, l: Latches) -> Result<(), PersistError> {
 }
 
 struct Shared {
-    /// The newest latch set the loop published ([`Latches::code`]; 0: none yet).
-    pending: AtomicU32,
-    /// What the file holds (its code), when known.
-    written: Mutex<Option<u32>>,
+    /// The newest latch set the loop published: its publication number in the high word, its
+    /// [`Latches::code`] in the low word (0: none yet).
+    pending: AtomicU64,
+    /// What the file holds, when known.
+    written: Mutex<Written>,
     saved: Condvar,
+}
+
+/// What the file holds: its code, and the newest publication it answers. The number, not the
+/// code, tells a flush that its set is on disk: a set published, replaced and published again
+/// (stop, then arm) has the old code while the write of the set between may still be under way.
+#[derive(Clone, Copy)]
+struct Written {
+    code: Option<u32>,
+    publication: u32,
+}
+
+fn pack(publication: u32, code: u32) -> u64 {
+    (u64::from(publication) << 32) | u64::from(code)
+}
+
+fn unpack(word: u64) -> (u32, u32) {
+    ((word >> 32) as u32, word as u32)
 }
 
 /// The loop's end: publishes the latch set without a lock or an allocation.
@@ -319,6 +337,7 @@ pub struct LatchPublisher {
     shared: Arc<Shared>,
     wake: SyncSender<()>,
     last: u32,
+    publication: u32,
 }
 
 impl LatchPublisher {
@@ -329,7 +348,10 @@ impl LatchPublisher {
             return;
         }
         self.last = code;
-        self.shared.pending.store(code, Ordering::Release);
+        self.publication = self.publication.wrapping_add(1);
+        self.shared
+            .pending
+            .store(pack(self.publication, code), Ordering::Release);
         // A full slot means a wake-up is already pending: the writer reads the newest word.
         let _ = self.wake.try_send(());
     }
@@ -338,12 +360,12 @@ impl LatchPublisher {
     /// the tick); true when it is.
     pub fn flush(&self, timeout: Duration) -> bool {
         let _ = self.wake.try_send(());
-        let last = self.last;
+        let publication = self.publication;
         LatchStore {
             shared: Arc::clone(&self.shared),
             path: PathBuf::new(),
         }
-        .wait(|c| c == Some(last), timeout)
+        .wait(|w| w.publication == publication, timeout)
     }
 }
 
@@ -367,10 +389,10 @@ impl LatchStore {
             .written
             .lock()
             .unwrap_or_else(|e| e.into_inner());
-        w.and_then(Latches::from_code)
+        w.code.and_then(Latches::from_code)
     }
 
-    fn wait(&self, done: impl Fn(Option<u32>) -> bool, timeout: Duration) -> bool {
+    fn wait(&self, done: impl Fn(Written) -> bool, timeout: Duration) -> bool {
         let guard = self
             .shared
             .written
@@ -387,7 +409,7 @@ impl LatchStore {
     /// Waits up to `timeout` until the file holds a set for which `done` is true.
     pub fn wait_written(&self, done: impl Fn(Latches) -> bool, timeout: Duration) -> bool {
         self.wait(
-            |w| w.and_then(Latches::from_code).is_some_and(&done),
+            |w| w.code.and_then(Latches::from_code).is_some_and(&done),
             timeout,
         )
     }
@@ -421,8 +443,11 @@ pub fn latch_channel(
     on_disk: Option<Latches>,
 ) -> (LatchPublisher, LatchStore, LatchWriter) {
     let shared = Arc::new(Shared {
-        pending: AtomicU32::new(0),
-        written: Mutex::new(on_disk.map(Latches::code)),
+        pending: AtomicU64::new(0),
+        written: Mutex::new(Written {
+            code: on_disk.map(Latches::code),
+            publication: 0,
+        }),
         saved: Condvar::new(),
     });
     let (wake, rx) = sync_channel(1);
@@ -431,6 +456,7 @@ pub fn latch_channel(
             shared: Arc::clone(&shared),
             wake,
             last: 0,
+            publication: 0,
         },
         LatchStore {
             shared: Arc::clone(&shared),
@@ -461,25 +487,45 @@ fn writer(path: &Path, shared: &Shared, wake: &Receiver<()>) {
             wake.recv_timeout(RETRY),
             Err(RecvTimeoutError::Disconnected)
         );
-        let code = shared.pending.load(Ordering::Acquire);
-        let known = *shared.written.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some(l) = Latches::from_code(code).filter(|_| known != Some(code)) {
-            match save(path, l) {
-                Ok(()) => {
-                    *shared.written.lock().unwrap_or_else(|e| e.into_inner()) = Some(code);
-                    shared.saved.notify_all();
-                    if failing {
-                        tracing::info!(path = %path.display(), "latches saved again");
-                    }
-                    failing = false;
+        let (publication, code) = unpack(shared.pending.load(Ordering::Acquire));
+        let known = shared
+            .written
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .code;
+        let Some(l) = Latches::from_code(code) else {
+            if gone {
+                return;
+            }
+            continue;
+        };
+        // One writer: when it reads the word, no write of its own is under way, so a file that
+        // already holds this set answers this publication without a write.
+        let result = if known == Some(code) {
+            Ok(())
+        } else {
+            save(path, l)
+        };
+        match result {
+            Ok(()) => {
+                *shared.written.lock().unwrap_or_else(|e| e.into_inner()) = Written {
+                    code: Some(code),
+                    publication,
+                };
+                shared.saved.notify_all();
+                if failing {
+                    tracing::info!(path = %path.display(), "latches saved again");
+                }
+                if known != Some(code) {
                     tracing::debug!(path = %path.display(), latched = %l.faults, hold = ?l.hold, "latches saved");
                 }
-                Err(e) => {
-                    if !failing {
-                        tracing::error!(error = %e, "latches NOT saved: a restart may not keep them; retrying every second");
-                    }
-                    failing = true;
+                failing = false;
+            }
+            Err(e) => {
+                if !failing {
+                    tracing::error!(error = %e, "latches NOT saved: a restart may not keep them; retrying every second");
                 }
+                failing = true;
             }
         }
         if gone {
@@ -614,6 +660,29 @@ mod tests {
             publisher.flush(Duration::from_secs(5)),
             "the cleared set reaches the disk"
         );
+        assert_eq!(load(&path).on_disk(), Some(Latches::default()));
+        assert_eq!(store.on_disk(), Some(Latches::default()));
+        drop(publisher);
+        std::fs::remove_dir_all(&dir).expect("clean up");
+    }
+
+    #[test]
+    fn a_flush_waits_for_its_own_publication_not_for_an_equal_older_set() {
+        // The file holds the empty set; a stop and an arm are published before the writer
+        // runs. The file's code equals the newest set, yet the stop's write may come first, so
+        // the flush must wait for the writer (CI saw the stop land after such a flush).
+        let dir = scratch("aba");
+        let path = latch_path(&dir);
+        save(&path, Latches::default()).expect("save");
+        let (mut publisher, store, writer) = latch_channel(path.clone(), Some(Latches::default()));
+        publisher.publish(Latches::of(set(&[Fault::StopRequested]), Hold::Free));
+        publisher.publish(Latches::default());
+        assert!(
+            !publisher.flush(Duration::from_millis(50)),
+            "no writer ran: the flush cannot be confirmed"
+        );
+        writer.spawn().expect("writer");
+        assert!(publisher.flush(Duration::from_secs(5)));
         assert_eq!(load(&path).on_disk(), Some(Latches::default()));
         assert_eq!(store.on_disk(), Some(Latches::default()));
         drop(publisher);
