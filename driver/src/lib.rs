@@ -28,6 +28,7 @@ pub mod service;
 pub mod socketcan_bus;
 pub mod startup;
 pub mod stats;
+pub mod tape;
 pub mod transport;
 pub mod tuning;
 pub mod units;

@@ -47,6 +47,12 @@ struct Args {
     /// Check the config and the model, print what would run, and exit.
     #[arg(long)]
     check: bool,
+    /// Record a tape to FILE (replaced if it exists): every frame the control loop read with
+    /// the receive time it used, every tick, command and fault from the bus, and every frame
+    /// the loop computed, so the run replays bit for bit (`handctl replay`). About 100 kB/s:
+    /// for tests and investigations, not for everyday use.
+    #[arg(long, value_name = "FILE")]
+    tape: Option<PathBuf>,
 }
 
 /// Whether the human-readable log may carry ANSI colours: only on a terminal, never in JSON
@@ -139,6 +145,7 @@ fn load_configured(config: &Config, check: bool) -> Result<Option<LoadedModel>, 
 fn build_engine(
     config: &Config,
     loaded: Option<&LoadedModel>,
+    tape: Option<driver::tape::Recorder>,
     now_us: u64,
 ) -> (Engine, ChainConfig) {
     let settings = engine_settings(config, loaded.map_or(0, |l| l.model_id));
@@ -156,6 +163,9 @@ fn build_engine(
             (Engine::without_model(&designed, settings, now_us), chain)
         }
     };
+    if let Some(t) = tape {
+        engine.record_to(t);
+    }
     engine.validated(now_us);
     (engine, chain)
 }
@@ -188,7 +198,15 @@ fn run(args: &Args) -> Result<(), String> {
             (SocketCanTransport::closed(&config.interface, clock), true)
         }
     };
-    let (mut engine, chain) = build_engine(&config, loaded.as_ref(), clock.now_us());
+    let (recorder, tape_writer) = match &args.tape {
+        Some(path) => {
+            let (r, w) = driver::tape::start(path).map_err(|e| e.to_string())?;
+            tracing::info!(tape = %path.display(), "recording a tape");
+            (Some(r), Some(w))
+        }
+        None => (None, None),
+    };
+    let (mut engine, chain) = build_engine(&config, loaded.as_ref(), recorder, clock.now_us());
     let latches = restored.latches();
     engine.restore(clock.now_us(), latches);
     let (publisher, store) = driver::persist::spawn_writer(latch_file, restored.on_disk())
@@ -252,6 +270,16 @@ fn run(args: &Args) -> Result<(), String> {
             safe_stops = sent,
             "stopping: {stops}; the latches could NOT be saved (see above)"
         );
+    }
+    let lost = runner.engine().tape().map_or(0, |t| t.lost());
+    // The engine holds the recorder: the writer ends once it is gone.
+    drop(runner);
+    if let Some(w) = tape_writer {
+        if w.finish() && lost == 0 {
+            tracing::info!("tape complete");
+        } else {
+            tracing::warn!(lost_entries = lost, "the tape is incomplete (see above)");
+        }
     }
     Ok(())
 }

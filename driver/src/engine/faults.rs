@@ -15,7 +15,7 @@ impl Engine {
     /// samples, an invalid window) and returns whether the window is valid.
     pub(super) fn evaluate_faults(&mut self, now_us: u64) -> bool {
         if now_us.saturating_sub(self.emg.last_emg_us) > self.settings.emg_silence_us {
-            self.raise(now_us, Fault::EmgSilence);
+            self.fault(now_us, Fault::EmgSilence);
         }
         // The amplifier's status fell silent: its last lead-off and saturation flags are stale,
         // and nothing says the amplifier still runs as the chain expects.
@@ -24,13 +24,13 @@ impl Engine {
             self.inputs.amp_reports_bad = true;
         }
         if self.emg.take_railed() >= RAIL_LIMIT || self.inputs.amp_reports_bad {
-            self.raise(now_us, Fault::SignalQuality);
+            self.fault(now_us, Fault::SignalQuality);
         }
         let valid = self
             .emg
             .window_valid(now_us, self.settings.tick_us, self.settings.max_gap_us);
         if self.emg.chain.faults().any_in_window() {
-            self.raise(now_us, Fault::NonFinite);
+            self.fault(now_us, Fault::NonFinite);
         } else if !valid
             && matches!(
                 self.safety.state(),
@@ -38,7 +38,7 @@ impl Engine {
             )
         {
             // Raised in SAFE too: the recovery time counts from the first valid window.
-            self.raise(now_us, Fault::InvalidWindow);
+            self.fault(now_us, Fault::InvalidWindow);
         }
         valid
     }

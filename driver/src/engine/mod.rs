@@ -37,6 +37,7 @@ use crate::safety::{
     DaemonState, Fault, FaultSet, FingerEvent, FingerWatch, Safety, SafetyTiming, Transition,
 };
 use crate::stats::Histogram;
+use crate::tape::{Entry, Recorded, Recorder};
 use crate::units::N_FINGERS;
 
 /// Most frames one tick sends: five setpoints, HAND_DIAG and HAND_HEARTBEAT.
@@ -147,6 +148,11 @@ pub struct Engine {
     epochs: epoch::Epochs,
     transitions: [Option<Transition>; 8],
     finger_events: [Option<FingerEvent>; N_FINGERS],
+    /// Where every input goes when handd records a tape (`crate::tape`), and what it needs to
+    /// say first: when the engine was built and its first epochs.
+    tape: Option<Recorder>,
+    built_us: u64,
+    built_epochs: [u16; N_FINGERS],
 }
 
 impl Engine {
@@ -185,6 +191,7 @@ impl Engine {
             "the bus carries {} EMG channels",
             hand_dbc::emg::EMG_CHANNELS
         );
+        let epochs = fresh_epochs();
         Self {
             emg: rx::EmgIn::new(chain, settings.max_gap_us, now_us),
             inputs: rx::Inputs::new(now_us),
@@ -202,11 +209,51 @@ impl Engine {
             counters: Counters::default(),
             timing: TickTiming::default(),
             tx: tx::Tx::new(),
-            epochs: epoch::Epochs::new(fresh_epochs()),
+            epochs: epoch::Epochs::new(epochs),
             transitions: [None; 8],
             finger_events: [None; N_FINGERS],
             settings,
+            tape: None,
+            built_us: now_us,
+            built_epochs: epochs,
         }
+    }
+
+    /// Records every input from now on to `tape`, and every tick's frames (see `crate::tape`):
+    /// call it right after construction, before anything else reaches the engine. Panics
+    /// otherwise (the tape would not replay).
+    pub fn record_to(&mut self, tape: Recorder) {
+        assert!(
+            self.counters.ticks == 0
+                && self.epochs.all() == self.built_epochs
+                && self.state() == DaemonState::Boot,
+            "a tape starts with the engine"
+        );
+        self.tape = Some(tape);
+        self.record(Entry::Built {
+            at_us: self.built_us,
+            epochs: self.built_epochs,
+            model_id: self.settings.model_id,
+        });
+    }
+
+    /// Starts every finger in `epochs` instead of fresh ones, right after construction (a
+    /// replay takes a tape's).
+    pub fn with_epochs(mut self, epochs: [u16; N_FINGERS]) -> Self {
+        self.epochs = epoch::Epochs::new(epochs);
+        self.built_epochs = epochs;
+        self
+    }
+
+    fn record(&mut self, e: Entry) {
+        if let Some(t) = &mut self.tape {
+            t.put(e);
+        }
+    }
+
+    /// The tape's recorder, if one is attached (its count of lost entries).
+    pub fn tape(&self) -> Option<&Recorder> {
+        self.tape.as_ref()
     }
 
     fn note(&mut self, t: Option<Transition>) {
@@ -223,11 +270,16 @@ impl Engine {
     /// Starts setpoint epoch `epoch` for finger `f` (a replay takes the recorded one): the
     /// finger gets a SAFE_STOP of it before anything else.
     pub fn begin_epoch(&mut self, f: usize, epoch: u16) {
+        self.record(Entry::BeganEpoch {
+            finger: f as u8,
+            epoch,
+        });
         self.epochs.begin(f, epoch);
     }
 
     /// Starts every finger's next setpoint epoch: the daemon calls it when the bus comes back.
     pub fn new_epoch(&mut self) {
+        self.record(Entry::NewEpoch);
         self.epochs.next();
     }
 
@@ -248,10 +300,11 @@ impl Engine {
 
     /// Config, model and bus are validated: BOOT -> READY (SAFE at once without a model).
     pub fn validated(&mut self, now_us: u64) {
+        self.record(Entry::Validated { at_us: now_us });
         let t = self.safety.validated(now_us);
         self.note(t);
         if self.predictor.is_none() {
-            self.raise(now_us, Fault::NoModel);
+            self.fault(now_us, Fault::NoModel);
         }
     }
 
@@ -265,30 +318,65 @@ impl Engine {
     /// [`Engine::validated`]: SAFE with each of them latched, and the calibrating hold as it
     /// was, so `arm` (after a deploy, for the hold) is needed as before the restart.
     pub fn restore(&mut self, now_us: u64, latches: crate::persist::Latches) {
+        self.record(Entry::Restored {
+            at_us: now_us,
+            faults: latches.faults,
+            hold: latches.hold,
+        });
         for f in latches.faults.iter() {
-            self.raise(now_us, f);
+            self.fault(now_us, f);
         }
         self.hold = latches.hold;
         if latches.hold == Hold::Calibrating {
-            self.raise(now_us, Fault::Calibrating);
+            self.fault(now_us, Fault::Calibrating);
         }
     }
 
     /// Report a fault found outside the engine (bus-off, interface down).
     pub fn raise(&mut self, now_us: u64, fault: Fault) {
+        self.record(Entry::Raised {
+            at_us: now_us,
+            fault,
+        });
+        self.fault(now_us, fault);
+    }
+
+    /// A fault the engine found itself.
+    fn fault(&mut self, now_us: u64, fault: Fault) {
         let t = self.safety.raise(now_us, fault);
         self.note(t);
     }
 
     /// Apply a technician's command (at the next tick's start, by the caller's ordering).
     pub fn command(&mut self, now_us: u64, cmd: Command) -> Result<(), crate::safety::ArmError> {
+        let recorded = match &cmd {
+            Command::SetGains(f, g) => Recorded::Gains(*f as u8, *g),
+            Command::Arm => Recorded::Arm,
+            Command::Stop => Recorded::Stop,
+            Command::Calibrating => Recorded::Calibrating,
+            // Recorded below, once the loop decided.
+            Command::Swap(_) => Recorded::Arm,
+        };
+        if !matches!(cmd, Command::Swap(_) | Command::SetGains(N_FINGERS.., _)) {
+            self.record(Entry::Command {
+                at_us: now_us,
+                command: recorded,
+            });
+        }
         match cmd {
             Command::SetGains(f, g) if f < N_FINGERS => self.settings.gains[f] = g,
             Command::SetGains(..) => {}
             Command::Arm => self.arm(now_us)?,
-            Command::Stop => self.raise(now_us, Fault::StopRequested),
+            Command::Stop => self.fault(now_us, Fault::StopRequested),
             Command::Calibrating => self.begin_hold(now_us),
-            Command::Swap(m) => self.swap_model(now_us, m),
+            Command::Swap(m) => {
+                let model_id = m.model_id;
+                let swapped = self.swap_model(now_us, m);
+                self.record(Entry::Command {
+                    at_us: now_us,
+                    command: Recorded::Swap { model_id, swapped },
+                });
+            }
         }
         Ok(())
     }
@@ -300,13 +388,28 @@ impl Engine {
     /// `started_us` only counts the lateness. Returns the frames to send, in order. No
     /// allocation.
     pub fn tick(&mut self, now_us: u64, started_us: u64) -> &[CanFrame] {
+        self.record(Entry::Tick {
+            deadline_us: now_us,
+            started_us,
+        });
         self.count_tick(now_us, started_us);
         let valid = self.evaluate_faults(now_us);
         self.run_model(now_us, valid);
         let t = self.safety.update(now_us, valid);
         self.note(t);
         self.update_watch(now_us);
-        self.transmit()
+        self.transmit();
+        self.record_out()
+    }
+
+    /// The frames just built, put on the tape too.
+    fn record_out(&mut self) -> &[CanFrame] {
+        if let Some(tape) = &mut self.tape {
+            for &frame in self.tx.frames() {
+                tape.put(Entry::Out { frame });
+            }
+        }
+        self.tx.frames()
     }
 
     fn count_tick(&mut self, now_us: u64, started_us: u64) {
@@ -335,19 +438,23 @@ impl Engine {
         // One channel beyond the calibration while the others are not: a pressed or lifted
         // electrode, not an effort. The predictor gave rest; the hand stops while it lasts.
         if predictor.last_implausible() {
-            self.raise(now_us, Fault::SignalQuality);
+            self.fault(now_us, Fault::SignalQuality);
         }
         if y.iter().all(|v| v.is_finite()) {
             self.labels = y;
         } else {
             self.labels = [0.0; N_FINGERS];
-            self.raise(now_us, Fault::NonFinite);
+            self.fault(now_us, Fault::NonFinite);
         }
     }
 
     /// The tick's frames were written at `written_us`, after `compute_us` of work: record the
     /// latency from the newest sample frame used.
     pub fn written(&mut self, written_us: u64, compute_us: u64) {
+        self.record(Entry::Written {
+            at_us: written_us,
+            compute_us,
+        });
         self.timing.compute.record(compute_us);
         // From the newest sample the tick had (the one its window ends at when the model ran),
         // whether or not the model ran: HAND_DIAG then says which samples each tick had.

@@ -296,6 +296,10 @@ impl Inputs {
 impl Engine {
     /// One received frame with its receive time.
     pub fn on_frame(&mut self, frame: &CanFrame, rx_us: u64) {
+        self.record(crate::tape::Entry::Frame {
+            rx_us,
+            frame: *frame,
+        });
         if frame.is_remote() || frame.is_extended() {
             self.counters.bad_frames += 1;
             return;

@@ -114,7 +114,7 @@ impl Engine {
     /// Begins the calibrating hold: SAFE, safe stops, `arm` refused until a model is swapped in.
     pub(super) fn begin_hold(&mut self, now_us: u64) {
         self.hold = Hold::Calibrating;
-        self.raise(now_us, Fault::Calibrating);
+        self.fault(now_us, Fault::Calibrating);
     }
 
     /// `arm`, refused during the calibrating hold and without a model.
@@ -135,7 +135,8 @@ impl Engine {
     /// from rest, until `arm`: see the module docs. A predictor that does not take the chain's
     /// features (the control side checks this first) is sent back unswapped: its id comes back
     /// unchanged.
-    pub(super) fn swap_model(&mut self, now_us: u64, mut m: Box<ModelSwap>) {
+    /// Whether it was swapped in.
+    pub(super) fn swap_model(&mut self, now_us: u64, mut m: Box<ModelSwap>) -> bool {
         let fits = m
             .predictor
             .as_ref()
@@ -153,7 +154,7 @@ impl Engine {
             // conditioner back to rest) until `arm`. A daemon that had no model never moved
             // the hand and refused `arm` until now: its first model needs no second `arm`.
             if m.predictor.is_some() {
-                self.raise(now_us, Fault::ModelSwapped);
+                self.fault(now_us, Fault::ModelSwapped);
             }
             for c in &mut self.conditioners {
                 c.reset();
@@ -164,6 +165,7 @@ impl Engine {
             // A sender that gave up waiting has dropped its end: the box is dropped here then.
             let _ = back.try_send(m);
         }
+        fits
     }
 }
 

@@ -9,6 +9,7 @@ use hand_dbc::CanFrame;
 use super::{Engine, MAX_TX_PER_TICK};
 use crate::conditioner::Setpoint;
 use crate::safety::DaemonState;
+use crate::tape::Entry;
 use crate::units::N_FINGERS;
 
 /// The outgoing frames and the E2E state of the protected ones.
@@ -154,20 +155,22 @@ impl Engine {
     /// when the outputs are not enabled (a bus failure latches SAFE); otherwise nothing, as the
     /// next tick carries the running setpoints. No allocation.
     pub fn safe_stop_frames(&mut self) -> &[CanFrame] {
+        self.record(Entry::SafeStops);
         self.tx.clear();
         if !self.safety.outputs_enabled() {
             self.build_setpoints(false);
         }
-        self.tx.frames()
+        self.record_out()
     }
 
     /// Safe-stop setpoints for every finger in its current epoch, whatever the state: the
     /// last round handd sends before it exits (SIGTERM), so no finger keeps an ACTIVE setpoint
     /// until its controller's own timeout. Changes no latch. No allocation.
     pub fn shutdown_frames(&mut self) -> &[CanFrame] {
+        self.record(Entry::Shutdown);
         self.tx.clear();
         self.build_setpoints(false);
-        self.tx.frames()
+        self.record_out()
     }
 }
 
