@@ -2,7 +2,9 @@
 //! (`stats_alloc`, which holds the unsafe code) around 10 s of real traffic from the simulated
 //! amplifier and finger controllers going through `Engine::on_frame`, 200 ticks and their
 //! latency bookkeeping, and the latch set published to the writer's channel every tick (its
-//! writer thread not started: it allocates, off the loop). Runs without the test harness so no other thread allocates while the
+//! writer thread not started: it allocates, off the loop), and every input and output put on a
+//! tape's queue (`handd --tape`; its writer not started either, so the queue fills and the
+//! rest is counted lost, the other path). Runs without the test harness so no other thread allocates while the
 //! region is measured.
 
 mod common;
@@ -48,6 +50,8 @@ fn main() {
         EngineSettings::default(),
         0,
     );
+    let (recorder, _queue) = driver::tape::unwritten(driver::tape::recorder::QUEUE_ENTRIES);
+    engine.record_to(recorder);
     engine.validated(0);
     let (mut latches, _store, _writer) =
         driver::persist::latch_channel(std::env::temp_dir().join("tick-alloc-latches"), None);
@@ -73,6 +77,9 @@ fn main() {
     }
     let stats = region.change();
     let ticks = engine.counters().ticks;
+    let lost = engine.tape().map_or(0, |t| t.lost());
+    println!("tape: {lost} entries lost once its queue was full");
+    assert!(lost > 0, "the full queue's path was taken");
     println!(
         "{ticks} ticks, {next} frames in, {sent} frames out, state {}: {} allocations, {} reallocations",
         engine.state(),

@@ -16,5 +16,5 @@ pub mod recorder;
 pub mod replay;
 
 pub use entry::{Entry, EntryError, Recorded, HEADER};
-pub use recorder::{start, Recorder, RecorderError, TapeWriter};
+pub use recorder::{start, unwritten, Recorder, RecorderError, TapeWriter};
 pub use replay::{read, replay, Difference, End, Replay, TapeError};

@@ -48,6 +48,20 @@ impl Recorder {
     }
 }
 
+/// A recorder whose entries stay in its queue of `capacity` (no file, no writer): for tests
+/// of what the engine's end does.
+pub fn unwritten(capacity: usize) -> (Recorder, Receiver<(u64, Entry)>) {
+    let (queue, rx) = sync_channel(capacity);
+    (
+        Recorder {
+            queue,
+            next: 0,
+            lost: 0,
+        },
+        rx,
+    )
+}
+
 /// Why a tape could not be started.
 #[derive(Debug, thiserror::Error)]
 pub enum RecorderError {
