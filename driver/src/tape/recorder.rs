@@ -18,8 +18,9 @@ use std::time::Duration;
 
 use super::entry::{Entry, HEADER};
 
-/// Entries the queue holds: about 2.5 s of a busy bus (3,250 frames/s and 140 tick entries/s).
-pub const QUEUE_ENTRIES: usize = 8192;
+/// Entries the queue holds: about 10 s of a busy bus (3,250 frames/s and 140 tick entries/s),
+/// so a writer starved by the real-time threads for seconds loses nothing (about 2.5 MB).
+pub const QUEUE_ENTRIES: usize = 32_768;
 /// How often the writer empties the queue into the file.
 pub const WRITE_EVERY: Duration = Duration::from_millis(20);
 

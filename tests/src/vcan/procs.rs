@@ -62,6 +62,16 @@ impl Proc {
         matches!(self.child.try_wait(), Ok(None))
     }
 
+    /// SIGTERM (as systemd stops a service), then waits up to `limit` for it to exit with 0.
+    pub fn terminate(&mut self, limit: Duration) {
+        let st = Command::new("kill")
+            .args(["-TERM", &self.pid().to_string()])
+            .status()
+            .expect("kill(1)");
+        assert!(st.success(), "kill -TERM {} failed: {st}", self.name);
+        self.wait_success(limit);
+    }
+
     /// SIGKILL, then reap.
     pub fn kill(&mut self) {
         let _ = self.child.kill();
@@ -165,14 +175,20 @@ impl TestConfig {
 
     /// Starts handd with this config.
     pub fn start(&self, env: &VcanEnv, dir: &Path) -> Proc {
+        self.start_with(env, dir, &[])
+    }
+
+    /// Starts handd with this config and `extra` arguments.
+    pub fn start_with(&self, env: &VcanEnv, dir: &Path, extra: &[&str]) -> Proc {
         // SCHED_FIFO for the control loop, as on the board (root in the VM): the simulated
         // world shares the CPU with it, and under emulation a normal-priority loop starves.
-        let args = vec![
+        let mut args = vec![
             "--config".to_string(),
             self.path.display().to_string(),
             "--rt-priority".into(),
             HANDD_FIFO.to_string(),
         ];
+        args.extend(extra.iter().map(|a| a.to_string()));
         let p = Proc::spawn(env, "handd", "handd", &args, dir);
         // handd is up once its control socket exists.
         let end = Instant::now() + Duration::from_secs(20);

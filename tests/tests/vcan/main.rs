@@ -20,7 +20,7 @@ use hand_dbc::messages::{EmgSamplesG0, FingerMode, FingerState};
 use hand_model::patient::{Target, TrackingConfig};
 use handstack_tests::vcan::monitor::{now_us, writer};
 use handstack_tests::vcan::procs::{handctl, handsim, DEADLINE_SLACK_MS};
-use handstack_tests::vcan::replay::{replay, ReplayReport};
+use handstack_tests::vcan::replay::replay_tape;
 use handstack_tests::vcan::{
     first_safe_stop_after, scenario_start_us, setpoints_of, statuses_of, Monitor, Proc, Seen,
     TestConfig, VcanEnv,
@@ -35,8 +35,8 @@ const DRILL_SILENCE_MS: u32 = 40;
 
 static MODEL: OnceLock<PathBuf> = OnceLock::new();
 static CALIBRATION_TRIED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-/// The closed loop's handd config and `handctl record` log, for the replay.
-static CLOSED_LOOP: OnceLock<(PathBuf, PathBuf)> = OnceLock::new();
+/// The closed loop's handd config, `handctl record` log and handd's tape, for the replay.
+static CLOSED_LOOP: OnceLock<(PathBuf, PathBuf, PathBuf)> = OnceLock::new();
 
 /// Where the calibration comes from (environment variables, for the VM's two boots).
 ///
@@ -199,9 +199,9 @@ fn b_closed_loop_tracks_a_sine_over_vcan() {
     let env = VcanEnv::get();
     let model = calibrated_model(&env).to_path_buf();
     let dir = env.scratch("closed-loop");
-    // The recorder starts first, so the log holds handd's every tick from its first one (the
-    // replay below runs the same engine from the same start). It is the only observer: a
-    // second socket would only load the machine.
+    // The recorder starts first, so the log holds handd's every frame from its first one (the
+    // replay compares them with handd's tape). It is the only observer besides candump: a
+    // third socket would only load the machine.
     let rec_dir = dir.join("recording");
     let mut rec = Proc::spawn(
         &env,
@@ -229,7 +229,8 @@ fn b_closed_loop_tracks_a_sine_over_vcan() {
     );
     std::thread::sleep(Duration::from_millis(300));
     let cfg = TestConfig::write(&env, &dir, &model, 100);
-    let _handd = cfg.start(&env, &dir);
+    let tape = dir.join("handd.tape");
+    let mut handd = cfg.start_with(&env, &dir, &["--tape", &tape.display().to_string()]);
     let rig = RigParts { env, dir, cfg };
     std::thread::sleep(Duration::from_millis(300));
     let mut sim = rig.sim("sine", 25.0, &[]);
@@ -244,10 +245,12 @@ fn b_closed_loop_tracks_a_sine_over_vcan() {
         "{running:?}"
     );
     rec.wait_success(Duration::from_secs(30));
+    // Stopped as systemd stops it: its tape ends with its last safe stops.
+    handd.terminate(Duration::from_secs(10));
     // The analysis reads handctl record's log: the recorder is under test too.
     let log =
         hand_dbc::candump::read_log(rec_dir.join("frames.log")).expect("the recording parses");
-    let _ = CLOSED_LOOP.set((rig.cfg.path.clone(), rec_dir.join("frames.log")));
+    let _ = CLOSED_LOOP.set((rig.cfg.path.clone(), rec_dir.join("frames.log"), tape));
     candump.kill();
     let raw = std::fs::read_to_string(candump.log_path()).expect("candump's output");
     let theirs = hand_dbc::candump::parse_log(&raw).expect("candump -L output parses");
@@ -1002,36 +1005,44 @@ fn c_tuning_kf_live_ramps_the_force_to_half() {
 }
 
 #[test]
-fn g_replaying_the_recorded_emg_through_the_engine_gives_the_same_setpoints() {
-    let env = VcanEnv::get();
-    let (cfg_path, log_path) = CLOSED_LOOP.get().cloned().unwrap_or_else(|| {
+fn g_replaying_handds_tape_through_the_engine_gives_every_frame_it_put_on_the_bus() {
+    let (cfg_path, log_path, tape_path) = CLOSED_LOOP.get().cloned().unwrap_or_else(|| {
         b_closed_loop_tracks_a_sine_over_vcan();
         CLOSED_LOOP
             .get()
             .cloned()
             .expect("the closed loop's recording")
     });
-    let _ = env;
     let config = driver::Config::load(&cfg_path).expect("the closed loop's config");
     let log = hand_dbc::candump::read_log(&log_path).expect("the recording parses");
-    let ReplayReport {
-        same,
-        different,
-        searched,
-        running,
-    } = replay(&config, &log);
+    let tape = driver::tape::read(&tape_path).expect("handd's tape reads");
+    let r = replay_tape(&config, &tape, &log);
     println!(
-        "replay: {same} of {} ticks of the running closed loop ({:.1} s) give the recorded \
-         setpoint frames bit for bit ({searched} of them only at a cut point other than the \
-         one HAND_DIAG names)",
-        same + different.len(),
-        (running.1 - running.0) as f64 * 1e-6
+        "replay: handd's tape ({} entries) through a fresh engine: {} ticks, {} rounds of \
+         frames bit for bit, {} differ; {} of handd's frames on the bus (handctl record) are \
+         the tape's, in order, from its first",
+        tape.len(),
+        r.replay.ticks,
+        r.replay.matched,
+        r.replay.differing,
+        r.on_bus
     );
-    assert!(same > 400, "only {same} ticks compared");
+    assert_eq!(r.replay.end, driver::tape::End::Tape, "the replay ended early");
+    assert!(r.replay.ticks > 450, "only {} ticks", r.replay.ticks);
+    assert_eq!(
+        r.replay.differing, 0,
+        "the replay differs from the tape: {:#?}",
+        r.replay.differences
+    );
+    // handctl record ran 27 s, handd ~26 s: the bus log holds every frame handd sent.
+    assert_eq!(
+        r.first_difference, None,
+        "handd's frames on the bus are not the tape's ({} agree)",
+        r.on_bus
+    );
     assert!(
-        different.is_empty(),
-        "{} ticks differ, the first at {:?} us after the first tick",
-        different.len(),
-        &different[..different.len().min(5)]
+        r.on_bus >= 7 * 450,
+        "only {} of handd's frames on the bus compared",
+        r.on_bus
     );
 }
