@@ -244,6 +244,27 @@ impl Default for DeployConfig {
     }
 }
 
+/// The input plausibility check (issue 25): a window with one channel beyond anything the
+/// calibration saw while the others are not (a pressed, lifted or hit electrode, not an
+/// effort) gives rest and raises `signal_quality` for as long as it lasts.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PlausibilityConfig {
+    /// A window is implausible when its most excessive channel (RMS over the calibration's
+    /// largest) is above 1 and more than `spread` times the median channel's. Lower catches
+    /// smaller artefacts and risks stopping a genuine uneven contraction; higher the reverse.
+    /// 1.5 to 100.
+    pub spread: f64,
+}
+
+impl Default for PlausibilityConfig {
+    fn default() -> Self {
+        Self {
+            spread: decoder::model::PLAUSIBLE_SPREAD,
+        }
+    }
+}
+
 /// The whole configuration.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -267,6 +288,8 @@ pub struct Config {
     pub control: ControlConfig,
     /// What `deploy` demands of a model's verification.
     pub deploy: DeployConfig,
+    /// The input plausibility check.
+    pub plausibility: PlausibilityConfig,
     /// Where handd keeps what must survive a restart (its latches: see `driver::persist`).
     pub state_dir: PathBuf,
 }
@@ -283,6 +306,7 @@ impl Default for Config {
             fingers: Fingers::default(),
             control: ControlConfig::default(),
             deploy: DeployConfig::default(),
+            plausibility: PlausibilityConfig::default(),
             state_dir: PathBuf::from("/var/lib/handstack"),
         }
     }
@@ -404,6 +428,11 @@ impl Config {
             "deploy.max_tolerance".into(),
             self.deploy.max_tolerance,
             (0.0, 0.5),
+        )?;
+        check_f64(
+            "plausibility.spread".into(),
+            self.plausibility.spread,
+            (1.5, 100.0),
         )?;
         if !(1..=10_000_000).contains(&self.deploy.min_rays) {
             return Err(ConfigError::Invalid {
@@ -564,6 +593,32 @@ mod tests {
         // the most that tick allows.
         let e = Config::from_toml("tick_ms = 100\n", Path::new("h.toml")).unwrap_err();
         assert!(e.to_string().contains("at most 5 per second"), "{e}");
+    }
+
+    #[test]
+    fn the_plausibility_spread_is_read_and_checked() {
+        let c = Config::from_toml("[plausibility]\nspread = 4.0\n", Path::new("h.toml")).unwrap();
+        assert_eq!(c.plausibility.spread, 4.0);
+        assert_eq!(
+            crate::startup::engine_settings(&c, 0).plausible_spread,
+            4.0,
+            "the engine gets it"
+        );
+        assert_eq!(
+            Config::default().plausibility.spread,
+            decoder::model::PLAUSIBLE_SPREAD
+        );
+        for bad in ["1.0", "101.0", "nan"] {
+            let e = Config::from_toml(
+                &format!("[plausibility]\nspread = {bad}\n"),
+                Path::new("h.toml"),
+            )
+            .unwrap_err();
+            assert!(
+                e.to_string().contains("plausibility.spread") || bad == "nan",
+                "{bad}: {e}"
+            );
+        }
     }
 
     #[test]

@@ -41,6 +41,9 @@ pub struct Counters {
     pub frames_tx: u64,
     /// Windows beyond the calibration's envelope, held inside it before the model.
     pub beyond_calibration: u64,
+    /// Windows found implausible (one channel far beyond the calibration, the others not).
+    #[serde(default)]
+    pub implausible: u64,
 }
 
 /// One EMG channel.
@@ -134,6 +137,7 @@ impl Live {
                 frames_rx: s.frames_rx,
                 frames_tx: s.frames_tx,
                 beyond_calibration: s.counters.beyond_calibration,
+                implausible: s.counters.implausible,
             },
             bus_load: s.bus_load,
             bus: crate::protocol::BusStatus {

@@ -123,6 +123,11 @@ pub struct Status {
     /// (absent from a daemon older than this field).
     #[serde(default)]
     pub beyond_calibration: u64,
+    /// Windows found implausible since start (one channel far beyond the calibration while
+    /// the others are not): rest and `signal_quality` (absent from a daemon older than this
+    /// field).
+    #[serde(default)]
+    pub implausible: u64,
     /// Newest sample frame received -> setpoints written.
     pub latency: Percentiles,
     /// Compute time of the tick.

@@ -147,6 +147,7 @@ impl ControlHandler {
             samples_lost: s.counters.samples_lost,
             bad_frames: s.counters.bad_frames,
             beyond_calibration: s.counters.beyond_calibration,
+            implausible: s.counters.implausible,
             latency: s.latency,
             compute: s.compute,
             lateness: s.lateness,

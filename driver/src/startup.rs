@@ -153,6 +153,7 @@ pub fn engine_settings(config: &Config, model_id: u32) -> EngineSettings {
         deadline_slack_us: config.deadline_slack_ms * 1000,
         gains: std::array::from_fn::<_, N_FINGERS, _>(|f| config.fingers.get(f).gains()),
         model_id,
+        plausible_spread: config.plausibility.spread,
     }
 }
 

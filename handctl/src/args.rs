@@ -56,6 +56,9 @@ pub enum Command {
     Monitor(MonitorArgs),
     /// Record a CAN bus to DIR/frames.log (candump) and, with handsim's trials, a session.
     Record(RecordArgs),
+    /// Replay a tape that handd recorded (`handd --tape FILE`) through a fresh engine and check
+    /// that every tick gives the frames handd computed, bit for bit.
+    Replay(ReplayArgs),
     /// The guided calibration of a patient: cues (terminal and bus), recording, a check of
     /// every trial (a failing one repeated at once), training, verification and a summary;
     /// writes DIR/session.toml, DIR/frames.log and DIR/model.hsm.
@@ -514,6 +517,21 @@ pub struct DecodeArgs {
     /// Print the agreement as JSON (exact numbers) instead of a table.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `handctl replay`.
+#[derive(Debug, Args)]
+pub struct ReplayArgs {
+    /// The tape (`handd --tape FILE`).
+    pub tape: PathBuf,
+    /// handd's config file of that run (its timeouts, gains and mains frequency decide the
+    /// ticks).
+    #[arg(long, default_value = driver::config::DEFAULT_CONFIG_PATH)]
+    pub config: PathBuf,
+    /// The model file that ran (default: the config's `model`). A tape whose run swapped
+    /// models replays up to the swap.
+    #[arg(long)]
+    pub model: Option<PathBuf>,
 }
 
 /// `handctl calibrate`.

@@ -71,7 +71,7 @@ pub fn format_status(s: &Status) -> String {
     out += &format!(
         "state {}   faults {}\n\
          ticks {}   deadline misses {}   EMG samples lost {}   bad frames {}   windows beyond \
-         the calibration {}\n\
+         the calibration {}   implausible {}\n\
          latency (newest sample -> setpoints) p50 {} us  p99 {} us  max {} us\n\
          compute per tick                     p50 {} us  p99 {} us  max {} us\n\
          tick start after its deadline        p50 {} us  p99 {} us  max {} us\n\
@@ -86,6 +86,7 @@ pub fn format_status(s: &Status) -> String {
         s.samples_lost,
         s.bad_frames,
         s.beyond_calibration,
+        s.implausible,
         s.latency.p50_us,
         s.latency.p99_us,
         s.latency.max_us,

@@ -55,6 +55,15 @@ pub enum CliError {
         /// The command line that builds it.
         build: &'static str,
     },
+    /// The run's model does not load under its config.
+    #[error(transparent)]
+    Startup(#[from] driver::startup::StartupError),
+    /// A tape could not be read or replayed.
+    #[error(transparent)]
+    Tape(#[from] driver::tape::TapeError),
+    /// A replay gave other frames than the tape holds.
+    #[error("{0} round(s) of frames differ from the tape (listed above)")]
+    ReplayDiffers(u64),
     /// The quality gates found trials to redo.
     #[error("the session failed its quality gates ({0} trial problem(s) above); redo those trials, or pass --ignore-gates")]
     Gates(usize),

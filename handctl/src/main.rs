@@ -24,6 +24,7 @@ mod listen;
 mod monitor;
 mod progress;
 mod record;
+mod replay;
 mod train;
 mod verify;
 
@@ -55,6 +56,7 @@ fn main() -> ExitCode {
         Command::Rollback(o) => deploy::rollback(o),
         Command::Monitor(a) => monitor::run(a),
         Command::Record(a) => record::run(a),
+        Command::Replay(a) => replay::run(a),
         Command::Calibrate(a) => calibrate::run(a),
         Command::Demo(a) => run_demo(a),
     };

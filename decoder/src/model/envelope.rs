@@ -55,6 +55,9 @@ pub struct Envelope {
     squared: Vec<bool>,
     /// The index of RMS among a channel's features.
     rms: usize,
+    /// The plausibility check's spread ([`PLAUSIBLE_SPREAD`] unless set): a setting of the
+    /// daemon (handd.toml), not of the model file.
+    spread: f64,
 }
 
 /// The index of VAR among a channel's features.
@@ -92,7 +95,12 @@ impl Envelope {
             .iter()
             .position(|n| *n == "RMS")
             .expect("RMS is one of the chain's features");
-        Ok(Self { max, squared, rms })
+        Ok(Self {
+            max,
+            squared,
+            rms,
+            spread: PLAUSIBLE_SPREAD,
+        })
     }
 
     /// The envelope of `rows` (raw feature vectors of `n` features each): per feature, the
@@ -151,8 +159,9 @@ impl Envelope {
         k
     }
 
-    /// Whether `x` is implausible: one channel beyond the calibration while the others are not
-    /// (see the module docs and [`PLAUSIBLE_SPREAD`]). No allocation.
+    /// Whether `x` is implausible: one channel beyond the calibration while the others are not,
+    /// its excess more than the spread ([`PLAUSIBLE_SPREAD`] by default) times the median
+    /// channel's (see the module docs). No allocation.
     #[inline]
     pub fn implausible(&self, x: &[f64]) -> bool {
         let rms = self.rms;
@@ -170,7 +179,19 @@ impl Envelope {
         }
         e.sort_unstable_by(f64::total_cmp);
         let median = e[channels / 2];
-        top > PLAUSIBLE_SPREAD * median
+        top > self.spread * median
+    }
+
+    /// Sets the plausibility check's spread (see [`Envelope::implausible`]); `spread` must be
+    /// finite and above 1 (the caller validated it: handd's config allows 1.5 to 100).
+    pub fn set_spread(&mut self, spread: f64) {
+        debug_assert!(spread.is_finite() && spread > 1.0, "spread {spread}");
+        self.spread = spread;
+    }
+
+    /// The plausibility check's spread.
+    pub fn spread(&self) -> f64 {
+        self.spread
     }
 
     /// `x` moved back along its effort ray into the envelope, written to `out`; returns the
@@ -267,6 +288,11 @@ mod tests {
             *v *= 10.0;
         }
         assert!(e.implausible(&x), "one electrode at ten times its level");
+        // The spread is the daemon's setting: at 20 the same window is plausible.
+        let mut wide = e.clone();
+        wide.set_spread(20.0);
+        assert!(!wide.implausible(&x), "spread 20: ten times is within it");
+        assert_eq!(wide.spread(), 20.0);
     }
 
     #[test]

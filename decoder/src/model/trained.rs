@@ -296,6 +296,14 @@ impl Predictor {
         y
     }
 
+    /// Sets the spread of the envelope's plausibility check (when the model has an envelope);
+    /// see [`Envelope::set_spread`].
+    pub fn set_plausible_spread(&mut self, spread: f64) {
+        if let Some(e) = &mut self.envelope {
+            e.set_spread(spread);
+        }
+    }
+
     /// The signal scale the envelope applied to the last window (1: inside the calibration,
     /// or no envelope).
     pub fn last_scale(&self) -> f64 {

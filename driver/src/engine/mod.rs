@@ -62,6 +62,9 @@ pub struct EngineSettings {
     pub gains: [FingerGains; N_FINGERS],
     /// Model identity for HAND_HEARTBEAT.
     pub model_id: u32,
+    /// The spread of the input plausibility check (`decoder::model::Envelope::implausible`),
+    /// applied to every model the engine runs.
+    pub plausible_spread: f64,
 }
 
 impl Default for EngineSettings {
@@ -75,6 +78,7 @@ impl Default for EngineSettings {
             deadline_slack_us: 5_000,
             gains: [FingerGains::default(); N_FINGERS],
             model_id: 0,
+            plausible_spread: decoder::model::PLAUSIBLE_SPREAD,
         }
     }
 }
@@ -98,6 +102,10 @@ pub struct Counters {
     /// (`decoder::model::Envelope`): a stronger grip than the calibration's, or an electrode
     /// far above its calibrated level.
     pub beyond_calibration: u64,
+    /// Windows found implausible (one channel far beyond the calibration while the others are
+    /// not: a pressed, lifted or hit electrode): the model gave rest, `signal_quality` was
+    /// raised.
+    pub implausible: u64,
 }
 
 /// Requests from technicians, applied at the next tick.
@@ -182,10 +190,13 @@ impl Engine {
 
     fn build(
         chain: &ChainSettings,
-        predictor: Option<Predictor>,
+        mut predictor: Option<Predictor>,
         settings: EngineSettings,
         now_us: u64,
     ) -> Self {
+        if let Some(p) = &mut predictor {
+            p.set_plausible_spread(settings.plausible_spread);
+        }
         assert!(
             chain.n_channels() <= hand_dbc::emg::EMG_CHANNELS,
             "the bus carries {} EMG channels",
@@ -438,6 +449,7 @@ impl Engine {
         // One channel beyond the calibration while the others are not: a pressed or lifted
         // electrode, not an effort. The predictor gave rest; the hand stops while it lasts.
         if predictor.last_implausible() {
+            self.counters.implausible += 1;
             self.fault(now_us, Fault::SignalQuality);
         }
         if y.iter().all(|v| v.is_finite()) {

@@ -145,6 +145,9 @@ impl Engine {
             && m.ticket.take();
         m.swapped = fits;
         if fits {
+            if let Some(p) = &mut m.predictor {
+                p.set_plausible_spread(self.settings.plausible_spread);
+            }
             std::mem::swap(&mut self.predictor, &mut m.predictor);
             std::mem::swap(&mut self.settings.model_id, &mut m.model_id);
             if self.hold == Hold::Calibrating {

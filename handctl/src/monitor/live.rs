@@ -44,6 +44,8 @@ impl MonitorState {
         d.deadline_misses = l.counters.deadline_misses;
         d.e2e_errors = l.counters.e2e_errors;
         d.samples_lost = l.counters.samples_lost;
+        d.beyond_calibration = l.counters.beyond_calibration;
+        d.implausible = l.counters.implausible;
         d.bus_load = Some(l.bus_load);
         if !l.bus.controller.is_empty() {
             let c = &l.bus.counters;

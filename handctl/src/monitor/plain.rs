@@ -58,7 +58,7 @@ pub fn line(st: &MonitorState, cpu: &CpuMeter) -> String {
     }));
     let (c, w) = cpu.used();
     format!(
-        "t {:.1} s {} faults {} model {} | latency p50 {} p99 {} us misses {} e2e {} lost {} bus {} CAN {} | rms uV {rms} | label/F/reported {fingers} | cpu {:.1}%",
+        "t {:.1} s {} faults {} model {} | latency p50 {} p99 {} us misses {} e2e {} lost {} beyond {} implausible {} bus {} CAN {} | rms uV {rms} | label/F/reported {fingers} | cpu {:.1}%",
         st.elapsed_s(),
         d.state.as_deref().unwrap_or("--"),
         if d.faults.is_empty() { "none".to_owned() } else { d.faults.join(",") },
@@ -68,6 +68,8 @@ pub fn line(st: &MonitorState, cpu: &CpuMeter) -> String {
         d.deadline_misses,
         d.e2e_errors,
         d.samples_lost,
+        d.beyond_calibration,
+        d.implausible,
         d.bus_load.map_or_else(|| "--".to_owned(), |l| format!("{:.1}%", l * 100.0)),
         d.can.as_deref().unwrap_or("--"),
         100.0 * c / w.max(1e-9),

@@ -63,6 +63,10 @@ pub struct DaemonView {
     pub e2e_errors: u64,
     /// EMG samples lost counted.
     pub samples_lost: u64,
+    /// Windows beyond the calibration's envelope (held inside it) counted.
+    pub beyond_calibration: u64,
+    /// Implausible windows counted (one channel far beyond the calibration, the others not).
+    pub implausible: u64,
     /// Bus load, fraction of the bit rate over the last second.
     pub bus_load: Option<f64>,
     /// The CAN controller's state and its error count since start, e.g. "error_active, 0

@@ -52,11 +52,7 @@ pub fn replay_tape(config: &driver::Config, tape: &[Entry], log: &[LogEntry]) ->
         .map(|e| e.frame)
         .filter(|f| from_handd(f.raw_id()))
         .collect();
-    let agree = on_bus
-        .iter()
-        .zip(&out)
-        .take_while(|(a, b)| a == b)
-        .count();
+    let agree = on_bus.iter().zip(&out).take_while(|(a, b)| a == b).count();
     let first_difference =
         (agree < on_bus.len()).then(|| (agree, on_bus[agree], out.get(agree).copied()));
     TapeReplay {

@@ -1027,7 +1027,11 @@ fn g_replaying_handds_tape_through_the_engine_gives_every_frame_it_put_on_the_bu
         r.replay.differing,
         r.on_bus
     );
-    assert_eq!(r.replay.end, driver::tape::End::Tape, "the replay ended early");
+    assert_eq!(
+        r.replay.end,
+        driver::tape::End::Tape,
+        "the replay ended early"
+    );
     assert!(r.replay.ticks > 450, "only {} ticks", r.replay.ticks);
     assert_eq!(
         r.replay.differing, 0,

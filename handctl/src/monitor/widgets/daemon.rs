@@ -1,5 +1,6 @@
 //! The daemon: state, faults in force, the model, tick latency, deadline misses, E2E errors,
-//! lost samples and bus load, in two lines. Counters are shown since the technician's last
+//! lost samples, windows beyond the calibration and implausible ones, and bus load, in two
+//! lines. Counters are shown since the technician's last
 //! reset of the view ([`Baseline`]); the daemon's own totals are not touched.
 
 use ratatui::buffer::Buffer;
@@ -19,6 +20,10 @@ pub struct Baseline {
     pub e2e_errors: u64,
     /// Lost samples then.
     pub samples_lost: u64,
+    /// Windows beyond the calibration then.
+    pub beyond_calibration: u64,
+    /// Implausible windows then.
+    pub implausible: u64,
 }
 
 impl Baseline {
@@ -28,6 +33,8 @@ impl Baseline {
             deadline_misses: d.deadline_misses,
             e2e_errors: d.e2e_errors,
             samples_lost: d.samples_lost,
+            beyond_calibration: d.beyond_calibration,
+            implausible: d.implausible,
         }
     }
 }
@@ -72,12 +79,14 @@ impl Widget for DaemonPanel<'_> {
             Span::raw(format!("  faults {faults}  model {model}")),
         ]);
         let second = Line::from(format!(
-            "latency p50 {} p99 {} us  misses {}  E2E {}  lost {}  bus {}  CAN {}",
+            "latency p50 {} p99 {} us  misses {}  E2E {}  lost {}  beyond cal {}  implausible {}  bus {}  CAN {}",
             opt(d.latency_p50_us),
             opt(d.latency_p99_us),
             d.deadline_misses.saturating_sub(b.deadline_misses),
             d.e2e_errors.saturating_sub(b.e2e_errors),
             d.samples_lost.saturating_sub(b.samples_lost),
+            d.beyond_calibration.saturating_sub(b.beyond_calibration),
+            d.implausible.saturating_sub(b.implausible),
             d.bus_load
                 .map_or_else(|| "--".to_owned(), |l| format!("{:.1}%", l * 100.0)),
             d.can.as_deref().unwrap_or("--"),
