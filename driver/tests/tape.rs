@@ -74,7 +74,7 @@ fn eventful_run(path: &Path) -> Vec<(u64, CanFrame)> {
     let (mut rig, writer) = taped(plan, path);
     rig.run_until(2_000_000);
     assert_eq!(rig.runner.engine().state(), DaemonState::Running);
-    let mut command = |rig: &mut Rig, at: u64, cmd: Command| {
+    let command = |rig: &mut Rig, at: u64, cmd: Command| {
         rig.run_until(at);
         let now = rig.clock.now_us();
         let _ = rig.runner.engine_mut().command(now, cmd);
