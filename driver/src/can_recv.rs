@@ -16,7 +16,7 @@
 use std::io::IoSliceMut;
 use std::os::fd::RawFd;
 
-use nix::sys::socket::{recvmsg, ControlMessageOwned, MsgFlags, SockaddrStorage};
+use nix::sys::socket::{recvmsg, ControlMessageOwned, MsgFlags};
 use nix::sys::time::TimeSpec;
 
 /// `sizeof(struct can_frame)`: a classic CAN frame as the kernel hands it to a raw socket.
@@ -157,7 +157,8 @@ impl RecvBuf {
 pub fn recv(fd: RawFd, buf: &mut RecvBuf) -> std::io::Result<(usize, RxMeta)> {
     let RecvBuf { frame, cmsg } = buf;
     let mut iov = [IoSliceMut::new(&mut frame[..])];
-    let msg = recvmsg::<SockaddrStorage>(
+    // No sender address: a raw CAN socket is bound to one interface, and none is needed.
+    let msg = recvmsg::<()>(
         fd,
         &mut iov,
         Some(&mut cmsg[..]),
