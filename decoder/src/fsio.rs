@@ -147,6 +147,12 @@ pub fn write_atomic_with(
     let tmp = temp_path(&dir, path)?;
     let write = || -> Result<(), WriteError> {
         let mut f = File::create(&tmp).map_err(step("create", &tmp))?;
+        // The file replaced keeps its permissions: a config installed 0640 stays 0640 after a
+        // rewrite (the temporary was created by the process's umask, 0644 under systemd).
+        if let Ok(old) = fs::metadata(path) {
+            f.set_permissions(old.permissions())
+                .map_err(step("set the permissions of", &tmp))?;
+        }
         fill(&mut f).map_err(step("write", &tmp))?;
         f.sync_all().map_err(step("fsync", &tmp))?;
         drop(f);
@@ -181,6 +187,19 @@ mod tests {
             .collect();
         v.sort();
         v
+    }
+
+    #[test]
+    fn a_rewrite_keeps_the_permissions_of_the_file_it_replaces() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = scratch("mode");
+        let p = d.join("handd.toml");
+        fs::write(&p, "a").expect("write");
+        fs::set_permissions(&p, fs::Permissions::from_mode(0o640)).expect("chmod");
+        write_atomic(&p, b"b").expect("rewrite");
+        let mode = fs::metadata(&p).expect("stat").permissions().mode() & 0o7777;
+        assert_eq!(mode, 0o640, "the rewrite changed mode 0640 to {mode:o}");
+        assert_eq!(fs::read(&p).expect("read"), b"b");
     }
 
     #[test]

@@ -6,6 +6,7 @@
 //! in-memory transport on the simulator (`hand-model`). `handd` neither needs nor links it.
 
 pub mod bus_load;
+pub mod can_recv;
 pub mod conditioner;
 pub mod config;
 pub mod control;

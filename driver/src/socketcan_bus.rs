@@ -3,7 +3,9 @@
 //! reaches the daemon, not silence: bus-off as an error ([`TransportError::BusOff`]), warning
 //! and error-passive (and the return to error-active) as the controller state in
 //! [`Transport::health`], every error class counted ([`crate::transport::BusCounters`]). A
-//! full transmit queue (ENOBUFS) is [`TransportError::QueueFull`], not a dead bus.
+//! full transmit queue (ENOBUFS) is [`TransportError::QueueFull`], not a dead bus. Frames the
+//! kernel drops from a full receive queue (SO_RXQ_OVFL, read with each frame's stamp by
+//! [`crate::can_recv`]) are counted as `kernel_drops`, not left to look like a silent amplifier.
 //!
 //! The receive buffer is sized for [`RCVBUF_BYTES`] (a few ticks of this bus); the kernel caps
 //! the request at `net.core.rmem_max`, and handd logs the size it got when that is less (the
@@ -21,6 +23,7 @@ use hand_clock::Clock;
 use hand_dbc::CanFrame;
 use socketcan::{CanSocket, EmbeddedFrame, Socket, SocketOptions};
 
+use crate::can_recv::{self, KernelDrops, RawFrame, RecvBuf};
 use crate::rx_times::RxTimes;
 use crate::transport::{BusHealth, ControllerState, Timestamped, Transport, TransportError};
 
@@ -114,7 +117,21 @@ pub struct SocketCanTransport<K: Clock> {
     socket: Option<CanSocket>,
     clock: K,
     rx_times: RxTimes,
+    rx_buf: RecvBuf,
+    drops: KernelDrops,
     health: BusHealth,
+}
+
+/// The id of a received frame (None for an id out of range, which the kernel never gives).
+fn can_id(id: u32, extended: bool) -> Option<socketcan::Id> {
+    if extended {
+        socketcan::ExtendedId::new(id).map(socketcan::Id::Extended)
+    } else {
+        u16::try_from(id)
+            .ok()
+            .and_then(socketcan::StandardId::new)
+            .map(socketcan::Id::Standard)
+    }
 }
 
 fn wall_us() -> i128 {
@@ -168,6 +185,8 @@ impl<K: Clock> SocketCanTransport<K> {
             socket: None,
             clock,
             rx_times: RxTimes::default(),
+            rx_buf: RecvBuf::default(),
+            drops: KernelDrops::default(),
             health: BusHealth::default(),
         }
     }
@@ -215,26 +234,39 @@ impl<K: Clock> SocketCanTransport<K> {
 
 impl<K: Clock> Transport for SocketCanTransport<K> {
     fn try_recv(&mut self) -> Result<Option<Timestamped>, TransportError> {
+        use std::os::fd::AsRawFd;
         loop {
             let Some(sock) = &self.socket else {
                 return Err(TransportError::Down(format!("{} is closed", self.iface)));
             };
-            let (frame, ts) = match sock.read_frame_with_timestamp() {
+            let (bytes, meta) = match can_recv::recv(sock.as_raw_fd(), &mut self.rx_buf) {
                 Ok(x) => x,
                 Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => return Ok(None),
                 Err(e) => return Err(self.map_io(e)),
             };
-            let ts_us = ts
-                .duration_since(UNIX_EPOCH)
-                .map(|d| d.as_micros() as i128)
-                .unwrap_or(0);
-            let rx_us = self.rx_times.map(ts_us, wall_us(), self.clock.now_us());
+            self.drops.seen(meta.drops);
+            self.health.counters.kernel_drops = self.drops.total();
+            if bytes != can_recv::CAN_MTU {
+                // Not a classic frame (the socket is CAN 2.0 only): nothing handd can read.
+                continue;
+            }
+            // Without a stamp (SO_TIMESTAMPNS refused), the frame's time is when it was read.
+            let now_wall = wall_us();
+            let ts_us = meta.stamp_us.unwrap_or(now_wall);
+            let rx_us = self.rx_times.map(ts_us, now_wall, self.clock.now_us());
             self.health.counters.clock_steps = self.rx_times.steps();
-            let ours = match frame {
-                socketcan::CanFrame::Data(d) => CanFrame::new(d.id(), d.data()),
-                socketcan::CanFrame::Remote(r) => CanFrame::new_remote(r.id(), r.dlc()),
-                socketcan::CanFrame::Error(e) => {
-                    if on_error_frame(e.error_bits(), e.data(), &mut self.health) {
+            let ours = match can_recv::decode(self.rx_buf.frame()) {
+                RawFrame::Data {
+                    id,
+                    extended,
+                    len,
+                    data,
+                } => can_id(id, extended).and_then(|i| CanFrame::new(i, &data[..len])),
+                RawFrame::Remote { id, extended, dlc } => {
+                    can_id(id, extended).and_then(|i| CanFrame::new_remote(i, dlc))
+                }
+                RawFrame::Error { bits, data } => {
+                    if on_error_frame(bits, &data, &mut self.health) {
                         return Err(TransportError::BusOff);
                     }
                     continue;
@@ -260,6 +292,7 @@ impl<K: Clock> Transport for SocketCanTransport<K> {
     }
 
     fn drop_queued(&mut self) {
+        self.drops.socket_closed();
         // Closing our socket stops this process writing until `reopen` (and then the daemon
         // sends only SAFE-state setpoints), but it purges nothing: `send` hands each frame
         // straight to the kernel, and a frame once written belongs to the interface, not to
@@ -283,7 +316,9 @@ impl<K: Clock> Transport for SocketCanTransport<K> {
     }
 
     fn reopen(&mut self) -> Result<(), TransportError> {
-        self.socket = None;
+        if self.socket.take().is_some() {
+            self.drops.socket_closed();
+        }
         interface_up(&self.iface)?;
         let sock = CanSocket::open(&self.iface).map_err(|e| self.map_io(e))?;
         sock.set_nonblocking(true).map_err(|e| self.map_io(e))?;
@@ -291,6 +326,11 @@ impl<K: Clock> Transport for SocketCanTransport<K> {
         sock.set_error_filter_accept_all()
             .map_err(|e| self.map_io(e))?;
         self.size_receive_buffer(&sock);
+        // Frames the kernel drops from a full receive queue, counted (kernel_drops).
+        if let Err(e) = nix::sys::socket::setsockopt(&sock, nix::sys::socket::sockopt::RxqOvfl, &1)
+        {
+            tracing::warn!(error = %e, "could not enable SO_RXQ_OVFL: kernel drops will read 0");
+        }
         self.health.state = ControllerState::ErrorActive;
         self.rx_times.reset();
         self.socket = Some(sock);

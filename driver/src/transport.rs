@@ -84,6 +84,11 @@ pub struct BusCounters {
     /// counted, never a fault.
     #[serde(default)]
     pub clock_steps: u64,
+    /// Frames the kernel dropped because the receive queue was full (SO_RXQ_OVFL; a tick
+    /// that started late or a stalled daemon): lost before handd read them, not on the bus.
+    /// 0 from transports without a kernel queue (in memory).
+    #[serde(default)]
+    pub kernel_drops: u64,
 }
 
 /// The bus's health now.

@@ -77,7 +77,7 @@ pub fn format_status(s: &Status) -> String {
          tick start after its deadline        p50 {} us  p99 {} us  max {} us\n\
          CAN controller {}   errors: warning {} passive {} bus-off {} restarted {} no-ACK {} \
          overflow {} protocol {} other {}; transmit queue full {}; reopen failures {}; wall-clock \
-         steps {}\n\n\
+         steps {}; receive queue drops (kernel) {}\n\n\
          {:<7} {:>7} {:>9} {:>11} {:>11} {:>7} {:>7}  {}\n",
         s.state,
         s.faults,
@@ -112,6 +112,7 @@ pub fn format_status(s: &Status) -> String {
         s.bus.counters.tx_queue_full,
         s.bus.counters.reopen_failures,
         s.bus.counters.clock_steps,
+        s.bus.counters.kernel_drops,
         "finger",
         "label",
         "force N",

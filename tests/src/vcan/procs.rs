@@ -20,6 +20,19 @@ impl Proc {
     /// Starts `bin` (one of the project's binaries, or an absolute path) with `args`; stdout
     /// and stderr go to `dir/<name>.log`.
     pub fn spawn(env: &VcanEnv, bin: &str, name: &str, args: &[String], dir: &Path) -> Self {
+        Self::spawn_as(env, bin, name, args, dir, None)
+    }
+
+    /// [`Proc::spawn`] as user `uid` and group `gid` (the process drops root's privileges
+    /// before it runs, as systemd's `User=` and `Group=` do); None runs as this process.
+    pub fn spawn_as(
+        env: &VcanEnv,
+        bin: &str,
+        name: &str,
+        args: &[String],
+        dir: &Path,
+        user: Option<(u32, u32)>,
+    ) -> Self {
         let log = dir.join(format!("{name}.log"));
         let out = File::create(&log).expect("log file in the scratch directory");
         let err = out.try_clone().expect("log file handle");
@@ -28,7 +41,12 @@ impl Proc {
         } else {
             env.bin(bin)
         };
-        let child = Command::new(&path)
+        let mut cmd = Command::new(&path);
+        if let Some((uid, gid)) = user {
+            use std::os::unix::process::CommandExt;
+            cmd.uid(uid).gid(gid);
+        }
+        let child = cmd
             .args(args)
             .stdin(Stdio::null())
             .stdout(out)
@@ -64,12 +82,16 @@ impl Proc {
 
     /// SIGTERM (as systemd stops a service), then waits up to `limit` for it to exit with 0.
     pub fn terminate(&mut self, limit: Duration) {
-        let st = Command::new("kill")
-            .args(["-TERM", &self.pid().to_string()])
-            .status()
-            .expect("kill(1)");
-        assert!(st.success(), "kill -TERM {} failed: {st}", self.name);
+        self.signal(rustix::process::Signal::TERM);
         self.wait_success(limit);
+    }
+
+    /// Sends `sig` (e.g. SIGSTOP, SIGCONT) without waiting.
+    pub fn signal(&self, sig: rustix::process::Signal) {
+        let pid = rustix::process::Pid::from_raw(self.child.id() as i32)
+            .expect("a child's pid is positive");
+        rustix::process::kill_process(pid, sig)
+            .unwrap_or_else(|e| panic!("cannot signal {}: {e}", self.name));
     }
 
     /// SIGKILL, then reap.
@@ -155,31 +177,73 @@ impl TestConfig {
     /// EMG and the finger silence timeouts. The state directory (the latch file) is `dir`, so
     /// no test's latches reach another's.
     pub fn write(env: &VcanEnv, dir: &Path, model: &Path, silence_ms: u32) -> Self {
-        let path = dir.join("handd.toml");
-        let socket = dir.join("handctl.sock");
+        Self::write_installed(
+            env,
+            &Layout {
+                config: dir.join("handd.toml"),
+                state_dir: dir.to_path_buf(),
+                socket: dir.join("handctl.sock"),
+                group: "root".into(),
+            },
+            model,
+            silence_ms,
+        )
+    }
+
+    /// Writes `layout.config` for `model` with the layout's state directory (latches, audit
+    /// log), control socket and socket group.
+    pub fn write_installed(env: &VcanEnv, layout: &Layout, model: &Path, silence_ms: u32) -> Self {
         let text = format!(
             "interface = \"{}\"\nmodel = \"{}\"\ntick_ms = 50\n\
              deadline_slack_ms = {DEADLINE_SLACK_MS}\nmains_hz = 50\nstate_dir = \"{}\"\n\n\
              [timeouts]\nemg_silence_ms = {silence_ms}\nfinger_silence_ms = {silence_ms}\n\
-             recovery_ms = 500\n\n[control]\nsocket = \"{}\"\ngroup = \"root\"\n\
+             recovery_ms = 500\n\n[control]\nsocket = \"{}\"\ngroup = \"{}\"\n\
              audit_log = \"{}\"\n",
             env.iface,
             model.display(),
-            dir.display(),
-            socket.display(),
-            dir.join("audit.log").display()
+            layout.state_dir.display(),
+            layout.socket.display(),
+            layout.group,
+            layout.state_dir.join("audit.log").display()
         );
-        std::fs::write(&path, text).expect("config in the scratch directory");
-        Self { path, socket }
+        std::fs::write(&layout.config, text).expect("write the config");
+        Self {
+            path: layout.config.clone(),
+            socket: layout.socket.clone(),
+        }
     }
 
     /// Starts handd with this config.
     pub fn start(&self, env: &VcanEnv, dir: &Path) -> Proc {
-        self.start_with(env, dir, &[])
+        self.start_as(env, dir, "handd", None)
     }
 
     /// Starts handd with this config and `extra` arguments.
     pub fn start_with(&self, env: &VcanEnv, dir: &Path, extra: &[&str]) -> Proc {
+        self.launch(env, dir, "handd", None, extra)
+    }
+
+    /// Starts handd with this config, its output in `dir/<name>.log`, as `user` (uid, gid;
+    /// None: as this process). Waits for its control socket: a socket file left by a killed
+    /// handd must be removed first, or this returns before the new one listens.
+    pub fn start_as(
+        &self,
+        env: &VcanEnv,
+        dir: &Path,
+        name: &str,
+        user: Option<(u32, u32)>,
+    ) -> Proc {
+        self.launch(env, dir, name, user, &[])
+    }
+
+    fn launch(
+        &self,
+        env: &VcanEnv,
+        dir: &Path,
+        name: &str,
+        user: Option<(u32, u32)>,
+        extra: &[&str],
+    ) -> Proc {
         // SCHED_FIFO for the control loop, as on the board (root in the VM): the simulated
         // world shares the CPU with it, and under emulation a normal-priority loop starves.
         let mut args = vec![
@@ -189,7 +253,7 @@ impl TestConfig {
             HANDD_FIFO.to_string(),
         ];
         args.extend(extra.iter().map(|a| a.to_string()));
-        let p = Proc::spawn(env, "handd", "handd", &args, dir);
+        let p = Proc::spawn_as(env, "handd", name, &args, dir, user);
         // handd is up once its control socket exists.
         let end = Instant::now() + Duration::from_secs(20);
         while !self.socket.exists() {
@@ -214,6 +278,19 @@ impl TestConfig {
             )
         })
     }
+}
+
+/// Where a handd config puts things.
+#[derive(Debug, Clone)]
+pub struct Layout {
+    /// The config file.
+    pub config: PathBuf,
+    /// The state directory (latches, audit log, deployed models beside the model).
+    pub state_dir: PathBuf,
+    /// The control socket.
+    pub socket: PathBuf,
+    /// The control socket's group.
+    pub group: String,
 }
 
 /// Starts handsim on the env's interface with `scenario` for `seconds`, plus extra arguments.

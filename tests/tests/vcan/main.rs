@@ -7,9 +7,13 @@
 //! receive time of its first EMG sample (counter 0), so fault onsets are placed on the bus.
 
 mod calibrate;
+mod clock_step;
 mod deploy;
 mod epoch;
+mod kernel_drops;
 mod monitor_tui;
+mod restart;
+mod service_user;
 mod subscribers;
 
 use std::path::{Path, PathBuf};
