@@ -53,7 +53,9 @@ print(json.dumps({"length": sig.length, "start": sig.start,
 /// The heartbeat handd's engine sends with `fault` raised (with `no_model` too: the engine
 /// runs without a model, which is a fault of its own).
 fn heartbeat_with(fault: Fault) -> Vec<u8> {
-    let chain = ChainConfig::default().validate().expect("the default chain");
+    let chain = ChainConfig::default()
+        .validate()
+        .expect("the default chain");
     let mut e = Engine::without_model(&chain, EngineSettings::default(), 0);
     e.validated(0);
     e.raise(10_000, fault);
@@ -146,7 +148,8 @@ fn cantools_names_every_fault_mask_bit_as_handd_sends_it() {
             .filter_map(Value::as_str)
             .collect();
         assert_eq!(
-            names, expected,
+            names,
+            expected,
             "handd raised {} (FaultMask {mask:#06x} on the bus): cantools names the bits \
              otherwise",
             f.name()

@@ -361,7 +361,12 @@ fn inject_active(rig: &mut Rig, epoch: u16, counter: u8, velocity: f64) {
     let mut frame = FingerSetpoint::new(STALE_FINGER, FingerMode::Active, force, velocity, epoch)
         .expect("in range")
         .to_frame();
-    seal(&mut frame, FingerSetpoint::E2E[STALE_FINGER], counter & 0x0F, false);
+    seal(
+        &mut frame,
+        FingerSetpoint::E2E[STALE_FINGER],
+        counter & 0x0F,
+        false,
+    );
     rig.probe.send(&frame).expect("the bus is on");
 }
 
@@ -391,7 +396,11 @@ fn after_shutdown_a_stale_setpoint_of_the_running_epoch_moves_no_finger() {
             FingerSetpoint::decode(f.raw_id(), f.data()).ok()
         })
         .expect("the last round reached the bus");
-    assert_eq!(last.mode(), FingerMode::SafeStop, "the last round is a safe stop");
+    assert_eq!(
+        last.mode(),
+        FingerMode::SafeStop,
+        "the last round is a safe stop"
+    );
     let node = |rig: &Rig| {
         let n = rig.world.fingers().nth(STALE_FINGER).expect("finger");
         (n.physics().angle_rad, n.epoch_gate().ignored())
@@ -406,7 +415,11 @@ fn after_shutdown_a_stale_setpoint_of_the_running_epoch_moves_no_finger() {
         "a stale ACTIVE setpoint of the epoch the fingers ran in moved the finger after \
          handd's last round (the round did not retire that epoch)"
     );
-    assert_eq!(n1, n0 + 1, "the controller counts the stale frame it ignored");
+    assert_eq!(
+        n1,
+        n0 + 1,
+        "the controller counts the stale frame it ignored"
+    );
     assert_ne!(last.epoch(), running, "the last round opened a new epoch");
     inject_active(&mut rig, last.epoch(), last.counter() + 2, v);
     world_until(&mut rig, t0 + 85_000);

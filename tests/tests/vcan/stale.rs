@@ -71,7 +71,12 @@ fn inject(w: &CanSocket, epoch: u16, counter: u8, velocity: f64) -> u64 {
     )
     .expect("in range");
     let mut frame = sp.to_frame();
-    seal(&mut frame, FingerSetpoint::E2E[FINGER], counter & 0x0F, false);
+    seal(
+        &mut frame,
+        FingerSetpoint::E2E[FINGER],
+        counter & 0x0F,
+        false,
+    );
     let out = socketcan::CanFrame::new(frame.id(), frame.data()).expect("a data frame");
     w.write_frame(&out).expect("vcan takes the injected frame");
     now_us()
