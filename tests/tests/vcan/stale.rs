@@ -147,9 +147,9 @@ fn check_stale_ignored(seen: &[Seen], w: &Window) {
         "only {} statuses between the stale frame and the control",
         during.len()
     );
-    let (lo, hi) = during
-        .iter()
-        .fold((w.here, w.here), |(lo, hi), s| (lo.min(s.1), hi.max(s.1)));
+    let (lo, hi) = during.iter().fold((f64::MAX, f64::MIN), |(lo, hi), s| {
+        (lo.min(s.1), hi.max(s.1))
+    });
     println!(
         "stale: running epoch {:#06x}, handd's last round {:?} in {:#06x}; the stale ACTIVE \
          ({} rad/s) of {:#06x}: finger {FINGER} within [{lo:.3}, {hi:.3}] rad over {} statuses, \
