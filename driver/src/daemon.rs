@@ -277,8 +277,8 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         self.bus_ok
     }
 
-    /// The last round before exit (SIGTERM): safe stops for every finger in its current epoch,
-    /// whatever the state, then the latches published and waited for on disk (up to
+    /// The last round before exit (SIGTERM): safe stops for every finger, each opening the
+    /// finger's next epoch (so its controller retires the one it ran in), whatever the state, then the latches published and waited for on disk (up to
     /// `save_wait`). Returns the safe stops sent and whether the latches are saved (true when
     /// there is no latch file).
     pub fn shutdown(&mut self, save_wait: std::time::Duration) -> (usize, bool) {

@@ -75,14 +75,11 @@ pub fn load_model(path: &Path, mains_hz: u32) -> Result<LoadedModel, StartupErro
     check_model(path, &bytes, mains_hz)
 }
 
-/// Parse the model file's `bytes` (read from `path`) and check that its chain fits the bus and
-/// `mains_hz`, as [`load_model`] does.
-pub fn check_model(path: &Path, bytes: &[u8], mains_hz: u32) -> Result<LoadedModel, StartupError> {
-    let model = TrainedModel::from_bytes(bytes, None).map_err(|source| StartupError::Model {
-        path: path.to_owned(),
-        source,
-    })?;
-    let c: &ChainConfig = model.chain();
+/// Check that the chain of the model at `path` fits the bus: its EMG channels and sample rate
+/// are the amplifier's. handd checks it of every model it runs or deploys
+/// ([`check_model`]), and `handctl monitor --model` of the model whose chain it runs on a bus
+/// or a log of it.
+pub fn check_fits_bus(path: &Path, c: &ChainConfig) -> Result<(), StartupError> {
     let mismatch = |what: String| StartupError::ModelMismatch {
         path: path.to_owned(),
         what,
@@ -99,11 +96,26 @@ pub fn check_model(path: &Path, bytes: &[u8], mains_hz: u32) -> Result<LoadedMod
             c.sample_rate_hz
         )));
     }
+    Ok(())
+}
+
+/// Parse the model file's `bytes` (read from `path`) and check that its chain fits the bus and
+/// `mains_hz`, as [`load_model`] does.
+pub fn check_model(path: &Path, bytes: &[u8], mains_hz: u32) -> Result<LoadedModel, StartupError> {
+    let model = TrainedModel::from_bytes(bytes, None).map_err(|source| StartupError::Model {
+        path: path.to_owned(),
+        source,
+    })?;
+    let c: &ChainConfig = model.chain();
+    check_fits_bus(path, c)?;
     if c.mains_hz != mains_hz {
-        return Err(mismatch(format!(
-            "its notch is at {} Hz but the config says mains_hz = {mains_hz}: retrain, or fix mains_hz",
-            c.mains_hz
-        )));
+        return Err(StartupError::ModelMismatch {
+            path: path.to_owned(),
+            what: format!(
+                "its notch is at {} Hz but the config says mains_hz = {mains_hz}: retrain, or fix mains_hz",
+                c.mains_hz
+            ),
+        });
     }
     let chain = c.validate().map_err(|source| StartupError::Chain {
         path: path.to_owned(),

@@ -1,7 +1,8 @@
 //! handd as a service, on the simulator and a virtual clock: a restart (a new engine and loop,
 //! restored from the latch file the old one's writer kept) never undoes an E-stop, a stop or
 //! the calibrating hold, and resumes when nothing was latched; a bus that is down at start is
-//! waited for, SAFE; the last round before exit is safe stops in the current epochs.
+//! waited for, SAFE; the last round before exit is safe stops, each opening a new epoch, so a
+//! stale setpoint of the epoch the fingers ran in moves nothing before the next daemon starts.
 
 mod common;
 
@@ -17,6 +18,7 @@ use driver::mem_transport::MemTransport;
 use driver::persist::{self, LatchStore, Latches, Restored};
 use driver::safety::{ArmError, DaemonState, Fault as DFault};
 use hand_dbc::messages::{FingerMode, FingerSetpoint};
+use hand_model::dbc::seal;
 use hand_model::faults::{Fault, FaultPlan};
 use hand_model::patient::Script;
 use hand_model::{Clock, VirtualClock};
@@ -292,7 +294,7 @@ fn with_the_bus_down_at_start_handd_stays_up_safe_and_runs_once_it_is_back() {
 }
 
 #[test]
-fn shutdown_sends_one_round_of_safe_stops_in_the_current_epochs_and_saves_the_latches() {
+fn shutdown_sends_one_round_of_safe_stops_in_new_epochs_and_saves_the_latches() {
     let file = scratch("sigterm");
     let (mut rig, _store) = rig(FaultPlan::new(), &file);
     rig.run_until(2_000_000);
@@ -308,6 +310,7 @@ fn shutdown_sends_one_round_of_safe_stops_in_the_current_epochs_and_saves_the_la
     rig.run_until(4_000_000);
     assert_runs(&rig, 3_500_000, 4_000_000, "before SIGTERM");
     let before = rig.seen.len();
+    let running = rig.runner.engine().epochs();
     let (sent, saved) = rig.runner.shutdown(WAIT);
     assert_eq!(sent, 5);
     assert!(saved, "the latches are on disk before exit");
@@ -329,8 +332,106 @@ fn shutdown_sends_one_round_of_safe_stops_in_the_current_epochs_and_saves_the_la
         );
         assert_eq!(
             m.epoch(),
-            rig.runner.engine().epoch(f),
-            "finger {f}'s current epoch"
+            running[f].wrapping_add(1),
+            "finger {f}: the last round opens the epoch after the one it ran in"
         );
     }
+}
+
+/// The finger the stale setpoint is aimed at (index).
+const STALE_FINGER: usize = 1;
+
+/// The daemon has exited: only the simulated hand runs on, to `t_end_us`.
+fn world_until(rig: &mut Rig, t_end_us: u64) {
+    let mut now = rig.clock.now_us();
+    while now < t_end_us {
+        now += 1000;
+        rig.clock.set_us(now);
+        rig.world.step(now);
+        while let Some(r) = rig.probe.receive_timestamped() {
+            rig.seen.push((r.time_us.unwrap_or(now), r.frame));
+        }
+    }
+}
+
+/// An ACTIVE setpoint of `epoch` for `STALE_FINGER` with alive counter `counter` and the
+/// right CRC (E2E accepts it), force of the velocity's sign (the controller moves only then).
+fn inject_active(rig: &mut Rig, epoch: u16, counter: u8, velocity: f64) {
+    let force = 20.0_f64.copysign(velocity);
+    let mut frame = FingerSetpoint::new(STALE_FINGER, FingerMode::Active, force, velocity, epoch)
+        .expect("in range")
+        .to_frame();
+    seal(
+        &mut frame,
+        FingerSetpoint::E2E[STALE_FINGER],
+        counter & 0x0F,
+        false,
+    );
+    rig.probe.send(&frame).expect("the bus is on");
+}
+
+/// Issue 29: between handd's exit and the next process's first SAFE_STOP, inside the
+/// controllers' 150 ms timeout, an ACTIVE setpoint of the epoch the fingers ran in (right
+/// CRC, alive counter in sequence: a frame left in a queue, or a replay) is ignored and
+/// counted; the same frame in the epoch the last round opened moves the finger (the control:
+/// the controller hears it and has not braked). Before the last round opened a new epoch,
+/// the stale frame was followed.
+#[test]
+fn after_shutdown_a_stale_setpoint_of_the_running_epoch_moves_no_finger() {
+    let file = scratch("sigterm-stale");
+    let (mut rig, _store) = rig(FaultPlan::new(), &file);
+    rig.run_until(2_000_000);
+    assert_eq!(rig.runner.engine().state(), DaemonState::Running);
+    let running = rig.runner.engine().epoch(STALE_FINGER);
+    let (sent, _) = rig.runner.shutdown(WAIT);
+    assert_eq!(sent, 5);
+    let t0 = rig.clock.now_us();
+    world_until(&mut rig, t0 + 5_000);
+    let last = rig
+        .seen
+        .iter()
+        .rev()
+        .find_map(|(_, f)| {
+            (f.raw_id() == FingerSetpoint::IDS[STALE_FINGER]).then_some(())?;
+            FingerSetpoint::decode(f.raw_id(), f.data()).ok()
+        })
+        .expect("the last round reached the bus");
+    assert_eq!(
+        last.mode(),
+        FingerMode::SafeStop,
+        "the last round is a safe stop"
+    );
+    let node = |rig: &Rig| {
+        let n = rig.world.fingers().nth(STALE_FINGER).expect("finger");
+        (n.physics().angle_rad, n.epoch_gate().ignored())
+    };
+    let (p0, n0) = node(&rig);
+    let v = if p0 < 0.8 { 4.0 } else { -4.0 };
+    inject_active(&mut rig, running, last.counter() + 1, v);
+    world_until(&mut rig, t0 + 45_000);
+    let (p1, n1) = node(&rig);
+    assert_eq!(
+        p1, p0,
+        "a stale ACTIVE setpoint of the epoch the fingers ran in moved the finger after \
+         handd's last round (the round did not retire that epoch)"
+    );
+    assert_eq!(
+        n1,
+        n0 + 1,
+        "the controller counts the stale frame it ignored"
+    );
+    assert_ne!(last.epoch(), running, "the last round opened a new epoch");
+    inject_active(&mut rig, last.epoch(), last.counter() + 2, v);
+    world_until(&mut rig, t0 + 85_000);
+    let moved = (node(&rig).0 - p0).abs();
+    println!(
+        "after shutdown: stale frame of epoch {running:#06x} ignored; the control in \
+         {:#06x} moved {moved:.3} rad",
+        last.epoch()
+    );
+    assert!(
+        moved > 0.02,
+        "the control moved the finger only {moved} rad: the test cannot tell an ignored \
+         frame from one that does not reach the controller"
+    );
 }

@@ -3,8 +3,9 @@
 //!
 //! Every setpoint carries its finger's current epoch: handd keeps one epoch per finger. The
 //! engine starts every finger at a fresh, unpredictable epoch ([`fresh_epoch`]) and moves
-//! *every* finger to its next one (+1, wrapping) on every change of state into SAFE and on every
-//! bus recovery (the daemon calls [`super::Engine::new_epoch`] after a reopen), but only finger f
+//! *every* finger to its next one (+1, wrapping) on every change of state into SAFE, on every
+//! bus recovery (the daemon calls [`super::Engine::new_epoch`] after a reopen) and in the last
+//! round before exit ([`super::Engine::shutdown_frames`]), but only finger f
 //! when finger f's controller reports that it braked by itself (FINGER_STATUS BRAKED with the
 //! setpoint-timeout bit, on the report's rising edge): that controller retired its epoch, the
 //! others did not, and they keep their force. In each of its epochs a finger gets a SAFE_STOP

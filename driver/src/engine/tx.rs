@@ -163,12 +163,17 @@ impl Engine {
         self.record_out()
     }
 
-    /// Safe-stop setpoints for every finger in its current epoch, whatever the state: the
-    /// last round handd sends before it exits (SIGTERM), so no finger keeps an ACTIVE setpoint
-    /// until its controller's own timeout. Changes no latch. No allocation.
+    /// Safe-stop setpoints for every finger, each opening the finger's next epoch, whatever
+    /// the state: the last round handd sends before it exits (SIGTERM), so no finger keeps an
+    /// ACTIVE setpoint until its controller's own timeout. The new epoch retires the one the
+    /// fingers ran in at once: until the next process's first SAFE_STOP, a stale ACTIVE
+    /// setpoint of it (a queued frame, a replay) is ignored, where a safe stop in the running
+    /// epoch would leave the controller bound to it for the rest of its 150 ms timeout.
+    /// Changes no latch. No allocation.
     pub fn shutdown_frames(&mut self) -> &[CanFrame] {
         self.record(Entry::Shutdown);
         self.tx.clear();
+        self.epochs.next();
         self.build_setpoints(false);
         self.record_out()
     }

@@ -64,10 +64,14 @@ impl Source {
 }
 
 /// The chain the bus and log sources run (the model's, with `--model`) and the rest levels
-/// to mark (the model's calibration's).
+/// to mark (the model's calibration's). A model whose chain does not fit the bus (and so a
+/// log of it: other channels, another sample rate) is refused, by the check handd makes of a
+/// model before it runs or deploys it.
 fn chain_and_rest(a: &MonitorArgs) -> Result<(ChainSettings, Option<Vec<f64>>), CliError> {
     if let Some(path) = &a.model {
         let model = TrainedModel::load(path, None)?;
+        driver::startup::check_fits_bus(path, model.chain())
+            .map_err(|e| CliError::Usage(format!("--model: {e}")))?;
         let settings = ChainSettings::try_new(model.chain())
             .map_err(|e| CliError::Usage(format!("--model {}: its chain: {e}", path.display())))?;
         return Ok((settings, model.rest_rms_uv().map(<[f64]>::to_vec)));
@@ -219,5 +223,43 @@ mod tests {
         let e = chain_and_rest(&monitor_args(&["--model", "/nonexistent.hsm"])).unwrap_err();
         assert!(e.to_string().contains("/nonexistent.hsm"), "{e}");
         std::fs::remove_file(&path).expect("removed");
+    }
+
+    /// A model of `channels` channels (default chain otherwise), saved to a scratch file.
+    fn saved_model(channels: usize, name: &str) -> std::path::PathBuf {
+        let chain = ChainConfig {
+            channels,
+            ..ChainConfig::default()
+        };
+        let n_in = 8 * chain.channels;
+        let spec = ModelSpec::default();
+        let model = AnyModel::random(ModelKind::ResDd, &spec, n_in, 5, 3).expect("model");
+        let norm = Normalizer::from_scales(vec![100.0; n_in]).expect("scales");
+        let summary = TrainingSummary::untrained(ModelKind::ResDd);
+        let trained = TrainedModel::new(model, spec, norm, chain, summary).expect("trained");
+        let path = std::env::temp_dir().join(format!("monitor-{name}-{}.hsm", std::process::id()));
+        trained.save(&path).expect("saved");
+        path
+    }
+
+    /// Issue 29: a 10-channel model on the 12-channel bus (or a log of it) is refused, as
+    /// handd refuses to run or deploy it, not shown as 10 channels without a word.
+    #[test]
+    fn a_model_whose_chain_does_not_fit_the_bus_is_refused_with_the_reason() {
+        let ten = saved_model(10, "ten");
+        let e = chain_and_rest(&monitor_args(&["--model", ten.to_str().unwrap()]))
+            .expect_err("a 10-channel model on the 12-channel bus");
+        let text = e.to_string();
+        assert!(
+            text.contains("trained on 10 EMG channels, the bus carries 12")
+                && text.contains(&ten.display().to_string()),
+            "the refusal names the model and the mismatch: {text}"
+        );
+        std::fs::remove_file(&ten).expect("removed");
+        let twelve = saved_model(hand_dbc::emg::EMG_CHANNELS, "twelve");
+        let (settings, _) = chain_and_rest(&monitor_args(&["--model", twelve.to_str().unwrap()]))
+            .expect("a model of the bus's channels is taken");
+        assert_eq!(settings.n_channels(), hand_dbc::emg::EMG_CHANNELS);
+        std::fs::remove_file(&twelve).expect("removed");
     }
 }

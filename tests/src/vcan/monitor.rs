@@ -16,6 +16,12 @@ pub struct Seen {
     pub time_us: u64,
     /// The data frame (None for an error frame).
     pub frame: Option<CanFrame>,
+    /// When the monitor's read returned it, µs since the epoch (the wall clock, as
+    /// [`now_us`]): a kernel stamp far from it tells a frame read late from one stamped late.
+    pub read_us: u64,
+    /// The monitor's socket it came from: 0 the first, one more at every reopen (the monitor
+    /// reopens when the interface went down).
+    pub socket: u32,
 }
 
 /// A running monitor.
@@ -47,14 +53,17 @@ impl Monitor {
         let (s2, st2, name) = (Arc::clone(&seen), Arc::clone(&stop), iface.to_owned());
         let thread = std::thread::spawn(move || {
             let mut sock = Some(sock);
+            let mut generation = 0;
             while !st2.load(Ordering::Relaxed) {
                 let Some(s) = &sock else {
                     std::thread::sleep(Duration::from_millis(5));
                     sock = try_open(&name);
+                    generation += u32::from(sock.is_some());
                     continue;
                 };
                 match s.read_frame_with_timestamp() {
                     Ok((f, ts)) => {
+                        let read_us = now_us();
                         let frame = match f {
                             socketcan::CanFrame::Data(d) => CanFrame::new(d.id(), d.data()),
                             socketcan::CanFrame::Remote(r) => CanFrame::new_remote(r.id(), r.dlc()),
@@ -64,6 +73,8 @@ impl Monitor {
                         v.push(Seen {
                             time_us: epoch_us(ts),
                             frame,
+                            read_us,
+                            socket: generation,
                         });
                     }
                     Err(e)

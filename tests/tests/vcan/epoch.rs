@@ -74,7 +74,7 @@ fn inject_after(reader: &CanSocket, w: &CanSocket, epoch: u16, velocity: f64) ->
 }
 
 /// FINGER_STATUS of `FINGER` in [from, to): (time, position, state, faults).
-fn statuses(seen: &[Seen], from: u64, to: u64) -> Vec<(u64, f64, FingerState, u8)> {
+pub(super) fn statuses(seen: &[Seen], from: u64, to: u64) -> Vec<(u64, f64, FingerState, u8)> {
     seen.iter()
         .filter(|s| (from..to).contains(&s.time_us))
         .filter_map(|s| {

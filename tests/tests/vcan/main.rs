@@ -14,6 +14,7 @@ mod kernel_drops;
 mod monitor_tui;
 mod restart;
 mod service_user;
+mod stale;
 mod subscribers;
 
 use std::path::{Path, PathBuf};
@@ -313,6 +314,9 @@ fn b_closed_loop_tracks_a_sine_over_vcan() {
         .map(|e| Seen {
             time_us: e.time_us,
             frame: Some(e.frame),
+            // A log's frame: no monitor read it.
+            read_us: e.time_us,
+            socket: 0,
         })
         .collect();
     let start = scenario_start_us(&seen);
@@ -760,10 +764,17 @@ fn d7_interface_down_and_up() {
         "handd sent ACTIVE setpoints after the interface went down (a latched fault)"
     );
     let while_down: Vec<_> = after.iter().filter(|s| s.time_us < up_begun).collect();
+    let evidence = link_evidence(&seen, down_at, up_at, &rig.handd.output());
+    println!(
+        "drill link-down: ip link set down {down_at}..{down_done} us, up {up_begun}..{up_at} \
+         us; the setpoints around them (as the monitor read them) and handd's own record:\n\
+         {evidence}"
+    );
     assert!(
         while_down.is_empty(),
         "handd's setpoints reached the bus while the interface was down (down from {down_done} \
-         to at least {up_begun} us, up by {up_at} us): {while_down:?}"
+         to at least {up_begun} us, up by {up_at} us): {while_down:?}; the evidence is printed \
+         above"
     );
     // Nothing can leave while the link is down: the bar runs from the link coming back.
     let stopped = first_safe_stop_after(&sps, up_at, &ALL).expect("every finger safe-stopped");
@@ -779,6 +790,46 @@ fn d7_interface_down_and_up() {
     );
     let st = rig.cfg.status(&rig.env);
     assert_eq!(st.state, "SAFE", "faults: {}", st.faults);
+}
+
+/// Evidence for d7: every setpoint stamped from 100 ms before the down to 100 ms after the up,
+/// each with its kernel stamp, how much later the monitor read it and from which of its
+/// sockets (it reopens when the link goes down), its epoch and alive counter (handd sends
+/// every finger a new epoch when it reopens the bus, so a frame's epoch says whether it was
+/// sent before the down or after handd reopened); then handd's log lines about the bus (when
+/// it saw the link fail and when it reopened, with the epochs it opened).
+fn link_evidence(seen: &[Seen], down_at: u64, up_at: u64, handd_log: &str) -> String {
+    use hand_dbc::messages::FingerSetpoint;
+    let mut out = String::new();
+    for s in seen
+        .iter()
+        .filter(|s| s.time_us + 100_000 >= down_at && s.time_us <= up_at + 100_000)
+    {
+        let Some(f) = &s.frame else { continue };
+        let Some(finger) = FingerSetpoint::instance_of(f.raw_id()) else {
+            continue;
+        };
+        let Ok(sp) = FingerSetpoint::decode(f.raw_id(), f.data()) else {
+            continue;
+        };
+        out.push_str(&format!(
+            "  stamp {} us (read {:+} us later, monitor socket {}): finger {finger} {:?} epoch \
+             {:#06x} counter {}\n",
+            s.time_us,
+            s.read_us as i64 - s.time_us as i64,
+            s.socket,
+            sp.mode(),
+            sp.epoch(),
+            sp.counter()
+        ));
+    }
+    for line in handd_log
+        .lines()
+        .filter(|l| l.contains("bus") || l.contains("epoch"))
+    {
+        out.push_str(&format!("  handd: {line}\n"));
+    }
+    out
 }
 
 #[test]

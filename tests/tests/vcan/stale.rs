@@ -1,0 +1,208 @@
+//! Issue 29: a stale setpoint in the window before the next epoch's first SAFE_STOP. handd is
+//! stopped (SIGTERM) mid-motion; right after its last round reaches the bus, inside the
+//! controllers' 150 ms timeout and before any next handd could open an epoch, an ACTIVE
+//! setpoint of the epoch the fingers ran in (right CRC, alive counter in sequence: a frame
+//! left in a queue, or a replay) is injected. The last round opens a new epoch, so the
+//! controller has retired that one: the finger does not move and the controller reports the
+//! ignored frame (FINGER_STATUS fault bit 6). The control: the same frame in the epoch the
+//! last round opened moves the finger, so the stale frame reached a controller that listened.
+
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+use hand_dbc::messages::{FingerMode, FingerSetpoint, FingerState};
+use hand_model::dbc::seal;
+use handstack_tests::vcan::monitor::{now_us, writer};
+use handstack_tests::vcan::Seen;
+use socketcan::{CanSocket, EmbeddedFrame, Frame, Socket};
+
+use super::epoch::statuses;
+use super::{wait_scenario_start, Rig, DRILL_SILENCE_MS, ONSET_US, RUN_S};
+
+/// The finger the stale setpoint is aimed at (index).
+const FINGER: usize = 1;
+/// FINGER_STATUS fault bit 6: a setpoint ignored by the epoch rule.
+const FAULT_STALE_EPOCH: u8 = 1 << 6;
+/// From the stale frame to the control, µs: three statuses (20 ms apart) to see the finger
+/// still, and the control still well inside the 150 ms timeout of the last round.
+const CONTROL_AFTER_US: u64 = 60_000;
+/// How far the finger may drift while the stale frame is judged, rad (2 status LSB).
+const STILL_RAD: f64 = 0.002;
+/// How far the control must move it at least, rad.
+const MOVED_RAD: f64 = 0.02;
+
+/// handd's setpoints for `FINGER` as the reader gets them, until (and with) the first one that
+/// is not ACTIVE: (the last ACTIVE one, the first other one).
+fn until_last_round(reader: &CanSocket) -> (FingerSetpoint, FingerSetpoint) {
+    let begun = Instant::now();
+    let mut active = None;
+    loop {
+        assert!(
+            begun.elapsed() < Duration::from_secs(3),
+            "handd sent no last round for finger {FINGER} within 3 s of SIGTERM"
+        );
+        let Ok(socketcan::CanFrame::Data(d)) = reader.read_frame() else {
+            continue;
+        };
+        let id = FingerSetpoint::IDS[FINGER];
+        if d.raw_id() != id {
+            continue;
+        }
+        let sp = FingerSetpoint::decode(id, d.data()).expect("handd's setpoint decodes");
+        if sp.mode() == FingerMode::Active {
+            active = Some(sp);
+            continue;
+        }
+        let active = active.expect("handd was RUNNING (ACTIVE setpoints) before SIGTERM");
+        return (active, sp);
+    }
+}
+
+/// An ACTIVE setpoint of `epoch` for `FINGER` with alive counter `counter`, right CRC (E2E
+/// accepts it) and force of the velocity's sign (the controller moves only then). Returns
+/// when it was written.
+fn inject(w: &CanSocket, epoch: u16, counter: u8, velocity: f64) -> u64 {
+    let sp = FingerSetpoint::new(
+        FINGER,
+        FingerMode::Active,
+        20.0_f64.copysign(velocity),
+        velocity,
+        epoch,
+    )
+    .expect("in range");
+    let mut frame = sp.to_frame();
+    seal(
+        &mut frame,
+        FingerSetpoint::E2E[FINGER],
+        counter & 0x0F,
+        false,
+    );
+    let out = socketcan::CanFrame::new(frame.id(), frame.data()).expect("a data frame");
+    w.write_frame(&out).expect("vcan takes the injected frame");
+    now_us()
+}
+
+#[test]
+fn stale_active_setpoint_before_the_next_epochs_safe_stop_after_sigterm_moves_no_finger() {
+    let mut rig = Rig::start("stale", DRILL_SILENCE_MS);
+    let mut sim = rig.sim("sine", RUN_S, &[]);
+    let w = writer(&rig.env.iface);
+    let reader = CanSocket::open(&rig.env.iface).expect("a reader socket");
+    reader
+        .set_read_timeout(Duration::from_millis(100))
+        .expect("read timeout");
+    let start = wait_scenario_start(&rig.monitor);
+    while now_us() < start + ONSET_US {
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    reader.set_nonblocking(true).expect("nonblocking");
+    while reader.read_frame().is_ok() {}
+    reader.set_nonblocking(false).expect("blocking");
+    let term = Command::new("kill")
+        .args(["-TERM", &rig.handd.pid().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(term.success(), "kill -TERM handd failed");
+    let (running, last) = until_last_round(&reader);
+    let here = statuses(&rig.monitor.snapshot(), start, now_us())
+        .last()
+        .map(|s| s.1)
+        .expect("finger status before the stale frame");
+    let velocity = if here < 0.8 { 4.0 } else { -4.0 };
+    let stale_at = inject(&w, running.epoch(), last.counter() + 1, velocity);
+    while now_us() < stale_at + CONTROL_AFTER_US {
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let control_at = inject(&w, last.epoch(), last.counter() + 2, velocity);
+    std::thread::sleep(Duration::from_millis(250));
+    rig.handd.wait_success(Duration::from_secs(10));
+    sim.wait_success(Duration::from_secs(60));
+    let seen = rig.monitor.finish();
+    let w = Window {
+        running,
+        last,
+        here,
+        velocity,
+        stale_at,
+        control_at,
+    };
+    check_stale_ignored(&seen, &w);
+    check_control_moved(&seen, &w);
+}
+
+/// What the drill did and when (µs on the kernel's time base).
+struct Window {
+    running: FingerSetpoint,
+    last: FingerSetpoint,
+    here: f64,
+    velocity: f64,
+    stale_at: u64,
+    control_at: u64,
+}
+
+fn check_stale_ignored(seen: &[Seen], w: &Window) {
+    let during = statuses(seen, w.stale_at, w.control_at);
+    assert!(
+        during.len() >= 2,
+        "only {} statuses between the stale frame and the control",
+        during.len()
+    );
+    let (lo, hi) = during.iter().fold((f64::MAX, f64::MIN), |(lo, hi), s| {
+        (lo.min(s.1), hi.max(s.1))
+    });
+    println!(
+        "stale: running epoch {:#06x}, handd's last round {:?} in {:#06x}; the stale ACTIVE \
+         ({} rad/s) of {:#06x}: finger {FINGER} within [{lo:.3}, {hi:.3}] rad over {} statuses, \
+         states {:?}",
+        w.running.epoch(),
+        w.last.mode(),
+        w.last.epoch(),
+        w.velocity,
+        w.running.epoch(),
+        during.len(),
+        during.iter().map(|s| s.2).collect::<Vec<_>>()
+    );
+    assert!(
+        during.iter().all(|s| s.2 != FingerState::Active),
+        "the controller went ACTIVE on a stale setpoint of the epoch the fingers ran in, after \
+         handd's last round (which did not open a new epoch: {:#06x} -> {:#06x})",
+        w.running.epoch(),
+        w.last.epoch()
+    );
+    assert!(
+        hi - lo <= STILL_RAD,
+        "a stale setpoint moved the finger after handd's last round: position {lo:.3}..{hi:.3} rad"
+    );
+    assert!(
+        during.iter().any(|s| s.3 & FAULT_STALE_EPOCH != 0),
+        "the controller never reported the stale setpoint it ignored (fault bit 6)"
+    );
+    assert_ne!(
+        w.last.epoch(),
+        w.running.epoch(),
+        "handd's last round did not open a new epoch"
+    );
+}
+
+/// The control: the same frame in the epoch the last round opened moves the finger.
+fn check_control_moved(seen: &[Seen], w: &Window) {
+    let before = statuses(seen, w.stale_at, w.control_at)
+        .last()
+        .map_or(w.here, |s| s.1);
+    let after = statuses(seen, w.control_at, w.control_at + 150_000);
+    let moved = after
+        .iter()
+        .map(|s| (s.1 - before).abs())
+        .fold(0.0, f64::max);
+    println!(
+        "stale: the control (same frame, epoch {:#06x}) moved the finger {moved:.3} rad ({} \
+         statuses after it)",
+        w.last.epoch(),
+        after.len()
+    );
+    assert!(
+        moved >= MOVED_RAD,
+        "the control moved the finger only {moved:.3} rad: the drill cannot tell an ignored \
+         frame from one that does not reach the controller"
+    );
+}
