@@ -43,8 +43,7 @@ const PLATEAU_AFTER_US: u64 = 700_000;
 /// The cue of movement `m` at `t_us` (rest before the first and after the last).
 fn cue_at(t_us: u64) -> CalibrationCue {
     let idle = || {
-        CalibrationCue::new(CuePhase::Idle, 255, 15, CueKind::Rest, 0, 0, 0.0, 0)
-            .expect("in range")
+        CalibrationCue::new(CuePhase::Idle, 255, 15, CueKind::Rest, 0, 0, 0.0, 0).expect("in range")
     };
     if t_us < FIRST_US {
         return idle();
@@ -204,7 +203,11 @@ fn the_inverted_finger_moves_the_other_way_at_its_own_cues_and_nothing_else_chan
         let same = pearson(&mine, &plateau(&plain, m));
         if usize::from(finger) == INVERTED {
             // The index's other cue is the neighbouring movement (flexion, then extension).
-            let other = if kind == CueKind::Flexion { m + 1 } else { m - 1 };
+            let other = if kind == CueKind::Flexion {
+                m + 1
+            } else {
+                m - 1
+            };
             let swapped = pearson(&mine, &plateau(&plain, other));
             println!(
                 "index {kind:?} cue: r against the plain patient's same cue {same:.3}, against \

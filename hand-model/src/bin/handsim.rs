@@ -142,11 +142,7 @@ fn build(scenario: Scenario, args: &Args) -> Result<ScenarioRun, SimError> {
         ("--weak-trial", args.weak_trial.is_some()),
         ("--inverted-finger", args.inverted_finger.is_some()),
     ];
-    let given: Vec<&str> = cued_options
-        .iter()
-        .filter(|o| o.1)
-        .map(|o| o.0)
-        .collect();
+    let given: Vec<&str> = cued_options.iter().filter(|o| o.1).map(|o| o.0).collect();
     match scenario {
         _ if given.is_empty() => scenario.build(args.seed),
         Scenario::Cued => ScenarioRun::cued(CuedConfig {

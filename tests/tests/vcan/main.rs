@@ -8,6 +8,7 @@
 
 mod calibrate;
 mod deploy;
+mod deploy_safety;
 mod epoch;
 mod monitor_tui;
 mod subscribers;
