@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use hand_dbc::messages::{CalibrationCue, FingerMode, FingerSetpoint, HandHeartbeat};
 use hand_model::dbc::seal;
 use handstack_tests::vcan::monitor::{now_us, writer};
-use handstack_tests::vcan::procs::{handctl, handsim, DEADLINE_SLACK_MS};
+use handstack_tests::vcan::procs::{handsim, DEADLINE_SLACK_MS};
 use handstack_tests::vcan::{
     first_safe_stop_after, Monitor, Seen, SetpointRecord, TestConfig, VcanEnv,
 };
