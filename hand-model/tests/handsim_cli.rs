@@ -116,6 +116,8 @@ fn bad_arguments_are_refused() {
         vec!["--session-out", "/tmp/x", "--scenario", "rest"],
         vec!["--mem", "--scenario", "cued", "--weak-trial", "255"],
         vec!["--mem", "--scenario", "cued", "--weak-trial", "-1"],
+        vec!["--mem", "--scenario", "cued", "--inverted-finger", "5"],
+        vec!["--mem", "--scenario", "sine", "--inverted-finger", "1"],
     ] {
         let out = handsim(&args);
         assert!(!out.status.success(), "{args:?} accepted");

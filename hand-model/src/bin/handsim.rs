@@ -28,7 +28,8 @@ delay of 250-450 ms (seeded by --seed) it contracts the cued finger, or the whol
 cued direction at the cued effort while the phase is HOLD (reaching it within 200 ms more), and
 lets go (over 500 ms) on RELAX, PREPARE, IDLE, DONE or ABORTED. Without a valid cue for 1 s it
 rests; with none at all it rests for the whole run (30 min unless --duration). E.g. beside
-handd:  handsim --iface vcan0 --scenario cued --weak-trial 3";
+handd:  handsim --iface vcan0 --scenario cued --weak-trial 3
+(--inverted-finger 1: the index finger's cues followed the wrong way round).";
 
 #[derive(Parser, Debug)]
 #[command(
@@ -79,6 +80,11 @@ struct Args {
     /// quality check can catch it and repeat the trial (later attempts are full).
     #[arg(long, value_name = "N")]
     weak_trial: Option<u8>,
+    /// With --scenario cued: follow finger F's (0 thumb .. 4 pinky) own cues the wrong way
+    /// round, every time: extend it at its flexion cue, flex it at its extension cue
+    /// (whole-hand cues as cued), so that a calibration's pattern gates can refuse the finger.
+    #[arg(long, value_name = "F")]
+    inverted_finger: Option<u8>,
     /// List the scenarios and faults, then exit.
     #[arg(long)]
     list_scenarios: bool,
@@ -132,15 +138,22 @@ fn parse_fingers(s: &str) -> Result<u8, SimError> {
 
 /// The scenario, with the cued patient's options from the command line.
 fn build(scenario: Scenario, args: &Args) -> Result<ScenarioRun, SimError> {
-    match (scenario, args.weak_trial) {
-        (_, None) => scenario.build(args.seed),
-        (Scenario::Cued, Some(n)) => ScenarioRun::cued(CuedConfig {
+    let cued_options = [
+        ("--weak-trial", args.weak_trial.is_some()),
+        ("--inverted-finger", args.inverted_finger.is_some()),
+    ];
+    let given: Vec<&str> = cued_options.iter().filter(|o| o.1).map(|o| o.0).collect();
+    match scenario {
+        _ if given.is_empty() => scenario.build(args.seed),
+        Scenario::Cued => ScenarioRun::cued(CuedConfig {
             seed: args.seed,
-            weak_trial: Some(n),
+            weak_trial: args.weak_trial,
+            inverted_finger: args.inverted_finger,
             ..CuedConfig::default()
         }),
-        (_, Some(_)) => Err(SimError::BadScript(format!(
-            "--weak-trial applies to --scenario cued only, not {}",
+        _ => Err(SimError::BadScript(format!(
+            "{} applies to --scenario cued only, not {}",
+            given.join(" and "),
             scenario.name()
         ))),
     }

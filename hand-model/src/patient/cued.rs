@@ -14,6 +14,10 @@
 //! - No valid cue for `cue_timeout_us` (1 s): back to rest at once (the pause was the delay).
 //! - [`CuedConfig::weak_trial`]: the first attempt (`Attempt` 0) of that trial is held at
 //!   `weak_level` (50 %) whatever the cue asks, so a quality check can catch and repeat it.
+//! - [`CuedConfig::inverted_finger`]: at that finger's own FLEXION cue the patient extends it,
+//!   at its EXTENSION cue flexes it (the two directions the wrong way round for one finger,
+//!   every repetition alike), so the calibration's pattern gates can catch the inverted finger.
+//!   Whole-hand cues are followed as cued.
 //!
 //! With the defaults a HOLD's plateau is reached at most 450 + 200 = 650 ms after the cue, and
 //! rest at most 450 + 500 = 950 ms after the RELAX.
@@ -51,6 +55,7 @@ use super::intent::Intent;
 use super::reaction::Reaction;
 use crate::emg::noise::GaussianNoise;
 use crate::error::{check_range, SimError};
+use crate::finger::N_FINGERS;
 use crate::nodes::std_id;
 
 /// Settings of the cued patient (checked once by [`CuedPatient::try_new`]).
@@ -76,6 +81,9 @@ pub struct CuedConfig {
     pub weak_trial: Option<u8>,
     /// The effort of that weak attempt, 0..=1, whatever the cue asks.
     pub weak_level: f64,
+    /// The finger (0..=4) whose own cues are followed the wrong way round: extension at its
+    /// flexion cue, flexion at its extension cue. Whole-hand cues are not inverted.
+    pub inverted_finger: Option<u8>,
 }
 
 impl Default for CuedConfig {
@@ -91,6 +99,7 @@ impl Default for CuedConfig {
             max_counter_delta: 3,
             weak_trial: None,
             weak_level: 0.5,
+            inverted_finger: None,
         }
     }
 }
@@ -150,6 +159,15 @@ impl CuedConfig {
                 "0..=254 (255 is no trial)",
             )?;
         }
+        if let Some(f) = self.inverted_finger {
+            us(
+                "inverted_finger",
+                u64::from(f),
+                0,
+                N_FINGERS as u64 - 1,
+                "0..=4 (a finger; the whole hand is not inverted)",
+            )?;
+        }
         check_range("weak_level", self.weak_level, 0.0, 1.0, "0..=1")
     }
 }
@@ -170,6 +188,8 @@ pub struct CueStats {
     pub timeouts: u64,
     /// Holds made at the weak level.
     pub weak_holds: u64,
+    /// Holds made in the direction opposite to the cue (the inverted finger's).
+    pub inverted_holds: u64,
 }
 
 /// A patient who does what the CALIBRATION_CUE frames say (see the module documentation).
@@ -275,8 +295,13 @@ impl CuedPatient {
         } else {
             key.requested_level()
         };
-        self.reaction
-            .schedule(t_us + delay, key.intent(level * (1.0 - shortfall)));
+        let mut aim = key.intent(level * (1.0 - shortfall));
+        let inverted = key.is_contraction() && self.cfg.inverted_finger == Some(key.finger);
+        if inverted {
+            self.stats.inverted_holds += 1;
+            aim = aim.reversed();
+        }
+        self.reaction.schedule(t_us + delay, aim);
     }
 }
 
@@ -320,6 +345,10 @@ mod tests {
             },
             CuedConfig {
                 effort_jitter: 0.9,
+                ..CuedConfig::default()
+            },
+            CuedConfig {
+                inverted_finger: Some(5),
                 ..CuedConfig::default()
             },
         ];

@@ -34,6 +34,12 @@ impl Intent {
         }))
     }
 
+    /// The opposite intent: every finger's flexion becomes extension of the same level and
+    /// the reverse.
+    pub fn reversed(&self) -> Intent {
+        Intent(self.0.map(|x| -x))
+    }
+
     /// The same intent with every finger clamped to -1..=1.
     pub fn clamped(&self) -> Intent {
         Intent(self.0.map(|x| x.clamp(-1.0, 1.0)))

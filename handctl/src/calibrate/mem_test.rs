@@ -63,18 +63,13 @@ impl Pace for SimClock {
     }
 }
 
-/// A world with the cued patient starting at `start_us`, and the tool's transport.
-fn rig(start_us: u64, weak_trial: Option<u8>, seed: u64) -> (MemTransport, SimClock) {
+/// A world with the cued patient `cued` starting at `start_us`, and the tool's transport.
+fn rig(start_us: u64, cued: CuedConfig) -> (MemTransport, SimClock) {
     let clock = VirtualClock::new();
     clock.set_us(start_us);
     let bus = MemBus::with_clock(clock.clone()).with_capacity(1 << 14);
     let tool = MemTransport(bus.endpoint());
-    let patient = PatientMode::cued(CuedConfig {
-        seed,
-        weak_trial,
-        ..CuedConfig::default()
-    })
-    .expect("a valid cued patient");
+    let patient = PatientMode::cued(cued).expect("a valid cued patient");
     let cfg = WorldConfig {
         start_us,
         ..WorldConfig::default()
@@ -103,7 +98,12 @@ fn run(
     stop_at: Option<u64>,
     resume: bool,
 ) -> Result<Recorded, CalibrateError> {
-    let (mut bus, mut sim) = rig(start_us, Some(WEAK), start_us + 1);
+    let cued = CuedConfig {
+        seed: start_us + 1,
+        weak_trial: Some(WEAK),
+        ..CuedConfig::default()
+    };
+    let (mut bus, mut sim) = rig(start_us, cued);
     let stop = Arc::new(AtomicBool::new(false));
     sim.stop_at = stop_at.map(|t| (t, Arc::clone(&stop)));
     let plan = Plan {
@@ -206,8 +206,79 @@ fn the_cued_patient_is_calibrated_in_memory_the_weak_trial_repeated_and_a_ctrl_c
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-fn train_and_summarize(dir: &Path) {
-    let opts = crate::args::TrainingOpts {
+/// The vcan drill's protocol for an inverted finger (tests/tests/vcan/deploy_safety.rs): one
+/// round of rest, index, middle and whole-hand flexion and extension.
+const INVERTED: &str = "repetitions = 1\nprepare_s = 1.0\nhold_s = 2.0\nrest_s = 3.0\n\
+                        relax_s = 1.5\nfingers = [\"index\", \"middle\", \"all\"]\n";
+
+#[test]
+fn a_patient_who_inverts_the_index_is_refused_by_the_gates_naming_it_and_no_model_is_written() {
+    for seed in [1, 2, 3] {
+        let dir = std::env::temp_dir().join(format!(
+            "handctl-calibrate-inverted-{seed}-{}",
+            std::process::id()
+        ));
+        let _ = std::fs::remove_dir_all(&dir);
+        let cued = CuedConfig {
+            seed,
+            inverted_finger: Some(1),
+            ..CuedConfig::default()
+        };
+        let (mut bus, mut sim) = rig(1_000_000, cued);
+        let plan = Plan {
+            protocol: Some(Protocol::parse(INVERTED, "inverted").expect("valid")),
+            dir: dir.clone(),
+            iface: "mem0".into(),
+            chain: super::chain(50),
+            resume: false,
+            max_resume_age_min: super::resume_check::DEFAULT_MAX_RESUME_AGE_MIN,
+            force_rest_mismatch: false,
+        };
+        let mut out = Output::new(Mode::Quiet, 10);
+        let stop = Arc::new(AtomicBool::new(false));
+        let done = record_session(&mut bus, &mut sim, &plan, &mut out, &stop)
+            .expect("every trial is recorded (one repetition: nothing to compare it with)");
+        assert_eq!(done.kept, 7, "rest and six movements");
+        let session = Session::open(&dir).expect("the session");
+        let report = check_gates(&session, &GateConfig::default()).expect("gates run");
+        let scores: Vec<String> = report
+            .patterns
+            .iter()
+            .map(|p| format!("{:?} {:+.2}", p.finger, p.swap_score.unwrap_or(f64::NAN)))
+            .collect();
+        println!("seed {seed}: swap scores {}", scores.join(", "));
+        let swapped: Vec<&GateKind> = report
+            .issues
+            .iter()
+            .map(|i| &i.kind)
+            .filter(|k| matches!(k, GateKind::SwappedDirections { .. }))
+            .collect();
+        assert_eq!(
+            swapped,
+            [&GateKind::SwappedDirections { finger: Some(1) }],
+            "seed {seed}: the index alone is refused as swapped:\n{report}"
+        );
+        let refused = super::training::train_session(
+            &dir,
+            &opts(),
+            decoder::model::verify::DEFAULT_TOLERANCE,
+            None,
+        );
+        let Err(e) = refused else {
+            panic!("seed {seed}: a model was trained on the inverted index")
+        };
+        assert_eq!(e.exit_code(), 3, "seed {seed}: {e}");
+        assert!(
+            !dir.join(super::training::MODEL_FILE).exists(),
+            "seed {seed}: a model file was written"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
+
+/// calibrate's training options by default (200 epochs at most).
+fn opts() -> crate::args::TrainingOpts {
+    crate::args::TrainingOpts {
         two_point: false,
         plain: false,
         no_rest_stage: false,
@@ -217,10 +288,13 @@ fn train_and_summarize(dir: &Path) {
         ignore_gates: false,
         allow_one_direction: false,
         validation: None,
-    };
+    }
+}
+
+fn train_and_summarize(dir: &Path) {
     let trained = super::training::train_session(
         dir,
-        &opts,
+        &opts(),
         decoder::model::verify::DEFAULT_TOLERANCE,
         Some("P-001"),
     )

@@ -9,6 +9,7 @@
 mod calibrate;
 mod clock_step;
 mod deploy;
+mod deploy_safety;
 mod epoch;
 mod kernel_drops;
 mod monitor_tui;
