@@ -290,8 +290,14 @@ mod tests {
     /// The kernel's side, on a socket this machine has (UDP on loopback; a CAN socket's
     /// SO_TIMESTAMPNS and SO_RXQ_OVFL messages are the same SOL_SOCKET ones): a receive queue
     /// that overflowed reports every drop with the next datagram queued, and every datagram
-    /// its stamp.
+    /// its stamp. Not under the ARM64 stage of the test command: qemu-user does not translate
+    /// SO_RXQ_OVFL (ENOPROTOOPT), so there it would test the emulator, not the kernel; it runs
+    /// natively on the x86-64 host, and the vcan suite's kernel_drops drill covers a CAN socket.
     #[test]
+    #[cfg_attr(
+        target_arch = "aarch64",
+        ignore = "qemu-user does not translate SO_RXQ_OVFL; runs natively on the host"
+    )]
     fn a_full_receive_queue_reports_its_drops_through_recv() {
         use nix::sys::socket::{setsockopt, sockopt};
         let rx = std::net::UdpSocket::bind("127.0.0.1:0").expect("a UDP socket on loopback");
