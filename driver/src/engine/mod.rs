@@ -360,34 +360,40 @@ impl Engine {
 
     /// Apply a technician's command (at the next tick's start, by the caller's ordering).
     pub fn command(&mut self, now_us: u64, cmd: Command) -> Result<(), crate::safety::ArmError> {
-        let recorded = match &cmd {
-            Command::SetGains(f, g) => Recorded::Gains(*f as u8, *g),
-            Command::Arm => Recorded::Arm,
-            Command::Stop => Recorded::Stop,
-            Command::Calibrating => Recorded::Calibrating,
-            // Recorded below, once the loop decided.
-            Command::Swap(_) => Recorded::Arm,
-        };
-        if !matches!(cmd, Command::Swap(_) | Command::SetGains(N_FINGERS.., _)) {
-            self.record(Entry::Command {
-                at_us: now_us,
-                command: recorded,
-            });
-        }
-        match cmd {
-            Command::SetGains(f, g) if f < N_FINGERS => self.settings.gains[f] = g,
-            Command::SetGains(..) => {}
-            Command::Arm => self.arm(now_us)?,
-            Command::Stop => self.fault(now_us, Fault::StopRequested),
-            Command::Calibrating => self.begin_hold(now_us),
+        let recorded = match cmd {
+            Command::SetGains(f, g) if f < N_FINGERS => {
+                self.settings.gains[f] = g;
+                Some(Recorded::Gains(f as u8, g))
+            }
+            // Out of range: nothing happens, nothing to replay.
+            Command::SetGains(..) => None,
+            Command::Arm => {
+                // A refused arm is on the tape too: the replay refuses it the same way.
+                self.record(Entry::Command {
+                    at_us: now_us,
+                    command: Recorded::Arm,
+                });
+                return self.arm(now_us);
+            }
+            Command::Stop => {
+                self.fault(now_us, Fault::StopRequested);
+                Some(Recorded::Stop)
+            }
+            Command::Calibrating => {
+                self.begin_hold(now_us);
+                Some(Recorded::Calibrating)
+            }
             Command::Swap(m) => {
                 let model_id = m.model_id;
                 let swapped = self.swap_model(now_us, m);
-                self.record(Entry::Command {
-                    at_us: now_us,
-                    command: Recorded::Swap { model_id, swapped },
-                });
+                Some(Recorded::Swap { model_id, swapped })
             }
+        };
+        if let Some(command) = recorded {
+            self.record(Entry::Command {
+                at_us: now_us,
+                command,
+            });
         }
         Ok(())
     }
