@@ -259,3 +259,41 @@ fn bus_off_stops_sending_drops_stale_setpoints_and_comes_back_safe() {
     r.run_until(ONSET + 2_200_000);
     assert_eq!(r.runner.engine().state(), DaemonState::Running);
 }
+
+#[test]
+fn a_stalled_daemon_sends_safe_stops_not_its_backlog_then_recovers() {
+    // The daemon stops for 500 ms (SIGSTOP, a stalled board) while the amplifier streams: its
+    // first tick after reads a backlog that is fresh for that tick's deadline, 500 ms ago, and
+    // stale by the time its setpoints go out. It must stop the fingers, not drive them from
+    // the past, and run again by itself once the signal is good.
+    let mut r = Rig::new(FaultPlan::new(), Script::resting(20_000_000));
+    r.run_until(ONSET);
+    assert_eq!(r.runner.engine().state(), DaemonState::Running);
+    r.stall_until(ONSET + 500_000);
+    let resumed = r.clock_now();
+    r.run_until(resumed + 1_000);
+    let first: Vec<_> = r
+        .setpoints()
+        .into_iter()
+        .filter(|s| s.0 >= resumed)
+        .collect();
+    assert_eq!(
+        first.len(),
+        5,
+        "one round of setpoints after the stall: {first:?}"
+    );
+    assert!(
+        first
+            .iter()
+            .all(|s| s.2 == FingerMode::SafeStop && s.3 == 0.0),
+        "the first tick after the stall drove the fingers from its backlog: {first:?}"
+    );
+    assert!(r.runner.engine().faults().contains(DFault::InvalidWindow));
+    r.run_until(resumed + 1_500_000);
+    assert_eq!(
+        r.runner.engine().state(),
+        DaemonState::Running,
+        "not running again 1.5 s after the stall: {}",
+        r.runner.engine().faults()
+    );
+}

@@ -115,6 +115,20 @@ impl<T: Transport> Rig<T> {
         }
     }
 
+    /// Advance to `t_end_us` with the daemon stopped (SIGSTOP, a stalled board): the world runs
+    /// and its frames queue up for the daemon, which runs no tick.
+    pub fn stall_until(&mut self, t_end_us: u64) {
+        let mut now = self.clock.now_us();
+        while now < t_end_us {
+            now += 1000;
+            self.clock.set_us(now);
+            self.world.step(now);
+            while let Some(r) = self.probe.receive_timestamped() {
+                self.seen.push((r.time_us.unwrap_or(now), r.frame));
+            }
+        }
+    }
+
     /// Setpoints seen, as (time, finger, mode, force, velocity).
     pub fn setpoints(&self) -> Vec<(u64, usize, FingerMode, f64, f64)> {
         self.seen

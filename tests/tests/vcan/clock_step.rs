@@ -64,7 +64,9 @@ impl Drop for SteppedClock {
 // otherwise. Run it with `VCAN_ARGS="--ignored clock_step"` once fixed, then remove this.
 #[ignore = "known defect: handd goes SAFE after a -1 h clock step (issue 30 item 5)"]
 fn field_clock_steps_keep_handd_running_and_reacting() {
-    let mut rig = Rig::start("clock-step", DRILL_SILENCE_MS);
+    let tape = std::env::temp_dir().join("clock-step.tape");
+    let tape_arg = tape.display().to_string();
+    let mut rig = Rig::start_with("clock-step", DRILL_SILENCE_MS, &["--tape", &tape_arg]);
     let mut sim = rig.sim("sine", 30.0, &[]);
     wait_active_after(&rig.monitor, 0, Duration::from_secs(10))
         .expect("handd never RUNNING before the steps");
@@ -86,6 +88,10 @@ fn field_clock_steps_keep_handd_running_and_reacting() {
             st.faults,
             st.bus.counters.clock_steps
         );
+        if st.state != "RUNNING" {
+            rig.handd.terminate(Duration::from_secs(5));
+            print_ticks_around_first_stop(&tape);
+        }
         assert!(
             st.state == "RUNNING" && st.faults == "none",
             "clock step {what}: handd is {} with faults {} (a step must not stale the windows)",
@@ -179,4 +185,75 @@ fn field_clock_steps_keep_handd_running_and_reacting() {
     );
     drop(clock);
     drop(rig);
+}
+
+/// What handd's tape says of the ticks around its first safe stop: for each tick its deadline,
+/// its start, the frames read for it and their receive times (handd's monotonic clock).
+fn print_ticks_around_first_stop(tape: &std::path::Path) {
+    use driver::tape::Entry;
+    use hand_dbc::messages::FingerSetpoint;
+    let entries = match driver::tape::read(tape) {
+        Ok(e) => e,
+        Err(e) => {
+            println!("handd's tape {} does not read: {e}", tape.display());
+            return;
+        }
+    };
+    // (deadline, started, frames, first rx, last rx, any stop sent)
+    let mut ticks: Vec<(u64, u64, usize, u64, u64, bool)> = Vec::new();
+    let (mut n, mut lo, mut hi) = (0usize, u64::MAX, 0u64);
+    for e in &entries {
+        match e {
+            Entry::Frame { rx_us, .. } => {
+                n += 1;
+                lo = lo.min(*rx_us);
+                hi = hi.max(*rx_us);
+            }
+            Entry::Tick {
+                deadline_us,
+                started_us,
+            } => {
+                ticks.push((*deadline_us, *started_us, n, lo, hi, false));
+                (n, lo, hi) = (0, u64::MAX, 0);
+            }
+            Entry::Out { frame } => {
+                let id = frame.raw_id();
+                if FingerSetpoint::instance_of(id).is_some() {
+                    let stop = FingerSetpoint::decode(id, frame.data())
+                        .map(|m| m.mode() != FingerMode::Active)
+                        .unwrap_or(true);
+                    if let Some(t) = ticks.last_mut() {
+                        t.5 |= stop;
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    let first_active = ticks.iter().position(|t| !t.5).unwrap_or(0);
+    let Some(first_stop) = ticks[first_active..].iter().position(|t| t.5) else {
+        println!("handd's tape: no stop after the first ACTIVE tick");
+        return;
+    };
+    let at = first_active + first_stop;
+    println!(
+        "handd's tape, ticks around its first stop (tick {at} of {}):",
+        ticks.len()
+    );
+    for (i, t) in ticks
+        .iter()
+        .enumerate()
+        .take(at + 8)
+        .skip(at.saturating_sub(6))
+    {
+        println!(
+            "  tick {i}: deadline {} started +{} us; {} frames rx {}..{}; {}",
+            t.0,
+            t.1.saturating_sub(t.0),
+            t.2,
+            if t.2 > 0 { t.3 } else { 0 },
+            t.4,
+            if t.5 { "stop" } else { "active" }
+        );
+    }
 }

@@ -20,11 +20,6 @@ use super::{Rig, ALL, DRILL_SILENCE_MS};
 const STALL: Duration = Duration::from_millis(500);
 
 #[test]
-// A known defect, found by this drill on 2026-12-02 (issue 30 stays open): after handd was
-// stopped for 500 ms (1211 frames dropped by the kernel, counted) its first setpoints after
-// SIGCONT were ACTIVE, 4 ms later, computed from the backlog read at once, instead of safe stops
-// until the signal is fresh again. Run it with `VCAN_ARGS="--ignored kernel_drops"` once fixed.
-#[ignore = "known defect: after a 500 ms stall handd drives from the stale backlog (issue 30)"]
 fn field_a_stalled_handd_counts_the_kernels_drops_then_recovers() {
     let rig = Rig::start("kernel-drops", DRILL_SILENCE_MS);
     let mut sim = rig.sim("sine", 8.0, &[]);

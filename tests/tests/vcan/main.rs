@@ -161,12 +161,17 @@ struct Rig {
 
 impl Rig {
     fn start(name: &str, silence_ms: u32) -> Self {
+        Self::start_with(name, silence_ms, &[])
+    }
+
+    /// As [`Rig::start`], handd with `extra` arguments.
+    fn start_with(name: &str, silence_ms: u32, extra: &[&str]) -> Self {
         let env = VcanEnv::get();
         let model = calibrated_model(&env).to_path_buf();
         let dir = env.scratch(name);
         let cfg = TestConfig::write(&env, &dir, &model, silence_ms);
         let monitor = Monitor::start(&env.iface);
-        let handd = cfg.start(&env, &dir);
+        let handd = cfg.start_with(&env, &dir, extra);
         Self {
             env,
             dir,
