@@ -513,6 +513,17 @@ impl<T: Transport, K: Clock> Runner<T, K> {
     /// snapshot, and move the deadline on by one period (absolute, so there is no drift).
     pub fn step(&mut self) {
         let now = self.clock.now_us();
+        // A tick that starts a whole period or more after its deadline (the process was
+        // stopped, the board stalled) runs at the latest deadline that has passed, on
+        // everything received up to it, and the deadlines it missed are skipped. At its own
+        // deadline it would read a backlog that was fresh then and stale now, and send a force
+        // computed from the past as if it were current. At the latest deadline the window is
+        // what the bus carried up to now: complete and fresh, it drives the hand (a stall that
+        // lost nothing is no fault); with frames lost in the stall (the kernel's queue
+        // overflowed) or none received lately, it is invalid and the tick sends safe stops.
+        if now >= self.next_deadline_us + self.tick_us {
+            self.next_deadline_us += (now - self.next_deadline_us) / self.tick_us * self.tick_us;
+        }
         let deadline = self.next_deadline_us;
         self.try_reopen(now);
         self.drain(deadline);
@@ -570,12 +581,8 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         if let Some(p) = &mut self.latches {
             p.publish(self.engine.latches());
         }
+        // A tick that ran past the next deadline: the next step skips what it missed.
         self.next_deadline_us += self.tick_us;
-        // After a long stall, skip the missed ticks rather than run them back to back.
-        if self.next_deadline_us + self.tick_us < t1 {
-            let behind = (t1 - self.next_deadline_us) / self.tick_us;
-            self.next_deadline_us += behind * self.tick_us;
-        }
     }
 
     /// Names a change of what the amplifier's status says (logged once per change, not per

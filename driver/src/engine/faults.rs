@@ -11,10 +11,9 @@ use crate::units::N_FINGERS;
 const RAIL_LIMIT: u64 = 5;
 
 impl Engine {
-    /// Raises the faults of the tick at `now_us` that started at `started_us` (EMG silence,
-    /// signal quality, non-finite samples, an invalid window) and returns whether the window
-    /// is valid.
-    pub(super) fn evaluate_faults(&mut self, now_us: u64, started_us: u64) -> bool {
+    /// Raises the faults of the tick at `now_us` (EMG silence, signal quality, non-finite
+    /// samples, an invalid window) and returns whether the window is valid.
+    pub(super) fn evaluate_faults(&mut self, now_us: u64) -> bool {
         if now_us.saturating_sub(self.emg.last_emg_us) > self.settings.emg_silence_us {
             self.fault(now_us, Fault::EmgSilence);
         }
@@ -27,12 +26,9 @@ impl Engine {
         if self.emg.take_railed() >= RAIL_LIMIT || self.inputs.amp_reports_bad {
             self.fault(now_us, Fault::SignalQuality);
         }
-        let valid = self.emg.window_valid(
-            now_us,
-            started_us,
-            self.settings.tick_us,
-            self.settings.max_gap_us,
-        );
+        let valid = self
+            .emg
+            .window_valid(now_us, self.settings.tick_us, self.settings.max_gap_us);
         if self.emg.chain.faults().any_in_window() {
             self.fault(now_us, Fault::NonFinite);
         } else if !valid

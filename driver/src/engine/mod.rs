@@ -410,7 +410,7 @@ impl Engine {
             started_us,
         });
         self.count_tick(now_us, started_us);
-        let valid = self.evaluate_faults(now_us, started_us);
+        let valid = self.evaluate_faults(now_us);
         self.run_model(now_us, valid);
         let t = self.safety.update(now_us, valid);
         self.note(t);

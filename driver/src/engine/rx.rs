@@ -136,22 +136,9 @@ impl EmgIn {
         since
     }
 
-    /// Whether the window ending at the newest sample may drive the fingers at the tick of
-    /// deadline `now_us` that started at `started_us`: full, no gap inside, fresh, the stream
-    /// still flowing, no bad sample in it.
-    ///
-    /// Fresh means fresh when the tick's setpoints go out, not only at its deadline: a tick that
-    /// starts long after its deadline (the process was stopped, the board stalled) reads a
-    /// backlog whose newest sample is fresh for the deadline but stale by the time the fingers
-    /// get the result. Such a tick sends safe stops (an invalid window), not a force computed
-    /// from the past.
-    pub(super) fn window_valid(
-        &self,
-        now_us: u64,
-        started_us: u64,
-        tick_us: u64,
-        max_gap_us: u64,
-    ) -> bool {
+    /// Whether the window ending at the newest sample may drive the fingers at `now_us`: full,
+    /// no gap inside, fresh, the stream still flowing, no bad sample in it.
+    pub(super) fn window_valid(&self, now_us: u64, tick_us: u64, max_gap_us: u64) -> bool {
         let window_len = self.chain.settings().window_len() as u64;
         let full = self.chain.samples_seen() >= window_len;
         let gap_left = self
@@ -159,7 +146,7 @@ impl EmgIn {
             .is_none_or(|at| self.samples_in - at >= window_len);
         let fresh = self
             .newest_rx_us
-            .is_some_and(|t| now_us.max(started_us).saturating_sub(t) <= 2 * tick_us);
+            .is_some_and(|t| now_us.saturating_sub(t) <= 2 * tick_us);
         // Silence longer than the gap limit is a gap in progress: the window will not be
         // complete, so stop now rather than wait for the silence timeout.
         let flowing = now_us.saturating_sub(self.last_emg_us) <= max_gap_us;

@@ -68,8 +68,19 @@ impl<T: Transport> Rig<T> {
         predictor: Predictor,
         wrap: impl FnOnce(MemTransport<VirtualClock>) -> T,
     ) -> Self {
+        Self::with_bus(faults, patient, predictor, wrap, |b| b)
+    }
+
+    /// As [`Rig::with_transport`], the bus shaped by `bus` first (e.g. its queue capacity).
+    pub fn with_bus(
+        faults: FaultPlan,
+        patient: PatientMode,
+        predictor: Predictor,
+        wrap: impl FnOnce(MemTransport<VirtualClock>) -> T,
+        bus: impl FnOnce(MemBus) -> MemBus,
+    ) -> Self {
         let clock = VirtualClock::new();
-        let bus = MemBus::with_clock(clock.clone());
+        let bus = bus(MemBus::with_clock(clock.clone()));
         let b = bus.clone();
         let world = World::try_new(
             WorldConfig {
