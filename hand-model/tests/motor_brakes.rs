@@ -370,3 +370,61 @@ fn a_short_estop_resumes_nothing_until_a_new_epoch() {
         FingerState::Active
     );
 }
+
+#[test]
+fn a_second_sender_interleaving_its_counters_moves_nothing_and_the_finger_brakes() {
+    // handd's setpoints (5 N flexion) and, from 755 ms, a second sender's (5 N extension) on
+    // the same id, both with correct CRCs, each counting from where the other would make its
+    // frames look in sequence: the second sender's first counter (0) follows handd's last
+    // (15, sent at 750 ms). With a reference that moves at once, every second frame is in
+    // sequence and the extension gets through; with Profile 1's sync counter a repeat or a
+    // jump needs two in-sequence frames before data is used again, which two interleaving
+    // senders never give: the controller obeys neither and brakes by itself.
+    const SECOND_AT_US: u64 = 755_000;
+    let mut h = Harness::new();
+    let mut mc_ep = h.bus.endpoint();
+    let mut a_ep = h.bus.endpoint();
+    let mut b_ep = h.bus.endpoint();
+    let mut mc = FingerNode::try_new(FINGER, FingerConfig::default(), 0).expect("valid");
+    let mut a = SetpointSource::try_new(FINGER, 0).expect("valid");
+    a.set(FingerMode::Active, 5.0, 0.5).expect("in range");
+    let mut b = SetpointSource::try_new(FINGER, SECOND_AT_US).expect("valid");
+    b.set(FingerMode::Active, -5.0, -0.5).expect("in range");
+    h.run(1_500_000, |t| {
+        a.poll(t, &mut a_ep);
+        if t >= SECOND_AT_US {
+            b.poll(t, &mut b_ep);
+        }
+        mc.poll(t, &mut mc_ep);
+    });
+    let statuses: Vec<(u64, FingerStatus)> = h
+        .with_id(FingerStatus::IDS[FINGER])
+        .into_iter()
+        .map(|(t, f)| (t, FingerStatus::decode(f.raw_id(), f.data()).expect("valid")))
+        .collect();
+    let before = statuses
+        .iter()
+        .rev()
+        .find(|(t, _)| *t < SECOND_AT_US)
+        .expect("a status before the second sender");
+    assert_eq!(before.1.state(), FingerState::Active);
+    let pushed_back = statuses
+        .iter()
+        .filter(|(t, _)| *t >= SECOND_AT_US)
+        .map(|(_, s)| s.force())
+        .fold(f64::INFINITY, f64::min);
+    assert!(
+        pushed_back >= 0.0,
+        "the second sender's extension reached the finger: force {pushed_back} N"
+    );
+    let braked_at = statuses
+        .iter()
+        .find(|(t, s)| *t >= SECOND_AT_US && s.state() == FingerState::Braked)
+        .map(|(t, _)| *t)
+        .expect("the controller must brake when two senders interleave");
+    assert!(
+        braked_at - SECOND_AT_US <= 200_000,
+        "braked {} µs after the second sender started",
+        braked_at - SECOND_AT_US
+    );
+}

@@ -16,9 +16,11 @@
 //! follows it only in the epoch it is bound to, which a SAFE_STOP opens; one it ignores sets
 //! fault bit 6 and feeds no watchdog. So after braking by itself or an E-stop (which retire its epoch)
 //! the controller moves again only after a SAFE_STOP of a new epoch (the first frame after a
-//! gap resynchronises the E2E counter, so it takes that frame and the SAFE_STOP after it).
+//! gap moves the E2E reference; the two in-sequence frames after it are not used, as AUTOSAR E2E
+//! Profile 1's sync counter has it, except that a SAFE_STOP among them stops the finger; the
+//! next SAFE_STOP then opens the epoch).
 
-use hand_dbc::e2e::E2eChecker;
+use hand_dbc::e2e::{E2eCheckConfig, E2eChecker};
 use hand_dbc::e2e::E2eStatus;
 use hand_dbc::messages::{self, EstopRequest, FingerSetpoint, FingerStatus, HandEstop};
 
@@ -76,8 +78,11 @@ impl FingerNode {
             return Err(SimError::BadFinger(finger));
         }
         cfg.validate()?;
-        let checker = E2eChecker::try_new(FingerSetpoint::E2E[finger], SETPOINT_MAX_DELTA)
-            .map_err(|e| SimError::BadScript(format!("setpoint E2E profile: {e}")))?;
+        let checker = E2eChecker::with_config(
+            FingerSetpoint::E2E[finger],
+            E2eCheckConfig::profile1(SETPOINT_MAX_DELTA),
+        )
+        .map_err(|e| SimError::BadScript(format!("setpoint E2E profile: {e}")))?;
         Ok(Self {
             finger,
             phys: FingerPhysics::at(cfg.angle_min_rad),
@@ -217,6 +222,23 @@ impl FingerNode {
                     self.ever_valid = true;
                     self.timed_out = false;
                 }
+                // A correct frame of a stream that is resynchronising (Profile 1's sync
+                // counter: after a counter jump, the next two in-sequence frames are not used).
+                // A jump is a restarted sender, lost frames or a second sender interleaving
+                // with the first; until two consecutive frames prove one sender again, nothing
+                // moves the finger, feeds the watchdog or opens an epoch. A SAFE_STOP still
+                // stops it: stopping is always safe, whoever asks.
+                (E2eStatus::Sync | E2eStatus::WrongSequence, Ok(sp))
+                    if sp.mode() == messages::FingerMode::SafeStop =>
+                {
+                    self.stop_command();
+                    if status == E2eStatus::WrongSequence {
+                        self.e2e_errors += 1;
+                        self.e2e_errors_since_status = true;
+                    }
+                }
+                // In sequence, not yet trusted: not an error.
+                (E2eStatus::Sync, Ok(_)) => {}
                 _ => {
                     self.e2e_errors += 1;
                     self.e2e_errors_since_status = true;
@@ -233,15 +255,20 @@ impl FingerNode {
                     // As when it brakes by itself: the epoch is retired and the command
                     // forgotten, so a RELEASE resumes nothing.
                     self.gate.braked_by_itself();
-                    self.cmd = Command {
-                        mode: FingerMode::SafeStop,
-                        force_n: 0.0,
-                        velocity_rad_s: 0.0,
-                    };
+                    self.stop_command();
                 }
                 self.estop = stop;
             }
         }
+    }
+
+    /// The command becomes a safe stop: zero force and velocity.
+    fn stop_command(&mut self) {
+        self.cmd = Command {
+            mode: FingerMode::SafeStop,
+            force_n: 0.0,
+            velocity_rad_s: 0.0,
+        };
     }
 
     /// FINGER_STATUS's fault bits now; the ones about setpoints since the previous status
