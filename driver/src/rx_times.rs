@@ -11,10 +11,15 @@
 //! [`RxTimes`] re-measures the offset at every read (two clock reads, no system call on vDSO
 //! platforms). When it moved by more than [`STEP_US`] the wall clock was stepped: the new offset
 //! applies from then on and the step is counted. A frame stamped before the step but read after
-//! it would map to a time far from the truth, so every mapped time is clamped between the last
-//! one (receive times never go back) and now (a frame was not received in the future). Such a
-//! frame's time is then off by at most the time it waited in the socket, a tick at most; every
-//! frame after it is exact again. Slow NTP slewing moves the offset by microseconds per second
+//! it would map to a time far from the truth, an hour early or late. Receive times never go
+//! back, so one mapped before the last time handed out takes that time. One mapped into the
+//! future (a backward step) also takes the last time handed out, not now: it was received
+//! before now and after that frame, and now is past the deadline of the tick that reads its
+//! backlog, so a frame placed at now is held back for the next tick, which holds back the
+//! next one again: one frame per tick while the backlog lasts, SAFE for seconds (the VM drill
+//! found this). A time within [`STEP_US`] of now is only the jitter of the two clock reads and
+//! is clamped to now. Such a frame's time is off by at most the time it waited in the socket, a
+//! tick at most; every frame after it is exact again. Slow NTP slewing moves the offset by microseconds per second
 //! and is followed without a step being counted.
 
 /// An offset change larger than this is a step of the wall clock, µs.
@@ -51,7 +56,13 @@ impl RxTimes {
         };
         self.offset_us = Some(offset);
         let mapped = (stamp_wall_us - offset).clamp(0, i128::from(u64::MAX)) as u64;
-        let t = mapped.clamp(self.last_us.min(mono_now_us), mono_now_us);
+        let earliest = self.last_us.min(mono_now_us);
+        let t = if u128::from(mapped) > u128::from(mono_now_us) + STEP_US as u128 {
+            // Stamped before a backward step: at the last frame's time, inside this tick.
+            earliest
+        } else {
+            mapped.clamp(earliest, mono_now_us)
+        };
         self.last_us = t;
         t
     }
@@ -101,13 +112,14 @@ mod tests {
             r.map(WALL0 + 999_000, WALL0 + 1_000_000, 1_000_000),
             999_000
         );
-        // The wall clock goes back an hour at monotonic 1.02 s. A frame stamped before the
-        // step, read after it: clamped to now, not an hour in the future.
+        // The wall clock goes back an hour at monotonic 1.02 s. Frames stamped before the
+        // step, read after it (a tick with deadline 1.025 s reading its backlog at 1.03 s):
+        // at the last frame's time, not an hour in the future, and not at the read time either,
+        // which is past the tick's deadline and would hold each back to the next tick.
         let wall = |mono: i128| WALL0 + mono - HOUR;
-        assert_eq!(
-            r.map(WALL0 + 1_010_000, wall(1_030_000), 1_030_000),
-            1_030_000
-        );
+        for stamped in [1_010_000, 1_015_000, 1_019_000] {
+            assert_eq!(r.map(WALL0 + stamped, wall(1_030_000), 1_030_000), 999_000);
+        }
         // Frames stamped after the step map exactly.
         assert_eq!(
             r.map(wall(1_040_000), wall(1_040_500), 1_040_500),
@@ -136,6 +148,22 @@ mod tests {
             1_040_000
         );
         assert_eq!(r.steps(), 1);
+    }
+
+    #[test]
+    fn a_stamp_just_past_now_is_jitter_and_clamped_to_now() {
+        let mut r = RxTimes::default();
+        assert_eq!(
+            r.map(WALL0 + 999_000, WALL0 + 1_000_000, 1_000_000),
+            999_000
+        );
+        // The wall clock read a few µs before the monotonic one: a frame stamped just then
+        // maps a little past now.
+        assert_eq!(
+            r.map(WALL0 + 1_010_003, WALL0 + 1_010_000, 1_009_990),
+            1_009_990
+        );
+        assert_eq!(r.steps(), 0);
     }
 
     #[test]

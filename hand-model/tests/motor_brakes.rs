@@ -400,7 +400,12 @@ fn a_second_sender_interleaving_its_counters_moves_nothing_and_the_finger_brakes
     let statuses: Vec<(u64, FingerStatus)> = h
         .with_id(FingerStatus::IDS[FINGER])
         .into_iter()
-        .map(|(t, f)| (t, FingerStatus::decode(f.raw_id(), f.data()).expect("valid")))
+        .map(|(t, f)| {
+            (
+                t,
+                FingerStatus::decode(f.raw_id(), f.data()).expect("valid"),
+            )
+        })
         .collect();
     let before = statuses
         .iter()

@@ -20,8 +20,8 @@
 //! Profile 1's sync counter has it, except that a SAFE_STOP among them stops the finger; the
 //! next SAFE_STOP then opens the epoch).
 
-use hand_dbc::e2e::{E2eCheckConfig, E2eChecker};
 use hand_dbc::e2e::E2eStatus;
+use hand_dbc::e2e::{E2eCheckConfig, E2eChecker};
 use hand_dbc::messages::{self, EstopRequest, FingerSetpoint, FingerStatus, HandEstop};
 
 use super::epoch::{EpochGate, Verdict};

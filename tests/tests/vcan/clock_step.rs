@@ -58,11 +58,6 @@ impl Drop for SteppedClock {
 }
 
 #[test]
-// A known defect, found by this drill on 2026-12-02 (issue 30 item 5 stays open): after a -1 h
-// step of the guest's clock handd went SAFE (emg_silence, invalid_window, signal_quality) and
-// stayed SAFE; `rx_times::tests` pass, so the real receive path (can_recv.rs) maps the stamps
-// otherwise. Run it with `VCAN_ARGS="--ignored clock_step"` once fixed, then remove this.
-#[ignore = "known defect: handd goes SAFE after a -1 h clock step (issue 30 item 5)"]
 fn field_clock_steps_keep_handd_running_and_reacting() {
     let tape = std::env::temp_dir().join("clock-step.tape");
     let tape_arg = tape.display().to_string();
