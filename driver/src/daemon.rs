@@ -509,21 +509,25 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         }
     }
 
+    /// A tick that starts a whole period or more after its deadline (the process was
+    /// stopped, the board stalled) runs at the latest deadline that has passed, on
+    /// everything received up to it, and the deadlines it missed are skipped. At its own
+    /// deadline it would read a backlog that was fresh then and stale now, and send a force
+    /// computed from the past as if it were current. At the latest deadline the window is
+    /// what the bus carried up to now: complete and fresh, it drives the hand (a stall that
+    /// lost nothing is no fault); with frames lost in the stall (the kernel's queue
+    /// overflowed) or none received lately, it is invalid and the tick sends safe stops.
+    fn skip_missed_deadlines(&mut self, now: u64) {
+        if now >= self.next_deadline_us + self.tick_us {
+            self.next_deadline_us += (now - self.next_deadline_us) / self.tick_us * self.tick_us;
+        }
+    }
+
     /// One tick: drain the bus, apply commands, run the engine, send its frames, publish the
     /// snapshot, and move the deadline on by one period (absolute, so there is no drift).
     pub fn step(&mut self) {
         let now = self.clock.now_us();
-        // A tick that starts a whole period or more after its deadline (the process was
-        // stopped, the board stalled) runs at the latest deadline that has passed, on
-        // everything received up to it, and the deadlines it missed are skipped. At its own
-        // deadline it would read a backlog that was fresh then and stale now, and send a force
-        // computed from the past as if it were current. At the latest deadline the window is
-        // what the bus carried up to now: complete and fresh, it drives the hand (a stall that
-        // lost nothing is no fault); with frames lost in the stall (the kernel's queue
-        // overflowed) or none received lately, it is invalid and the tick sends safe stops.
-        if now >= self.next_deadline_us + self.tick_us {
-            self.next_deadline_us += (now - self.next_deadline_us) / self.tick_us * self.tick_us;
-        }
+        self.skip_missed_deadlines(now);
         let deadline = self.next_deadline_us;
         self.try_reopen(now);
         self.drain(deadline);

@@ -34,16 +34,7 @@ fn run(corruption: SetpointCorruption) -> (u64, u64, Harness) {
         .filter(|t| *t < STOP_AT_US)
         .max()
         .expect("setpoints were sent");
-    let statuses: Vec<(u64, FingerStatus)> = h
-        .with_id(FingerStatus::IDS[FINGER])
-        .into_iter()
-        .map(|(t, f)| {
-            (
-                t,
-                FingerStatus::decode(f.raw_id(), f.data()).expect("valid status"),
-            )
-        })
-        .collect();
+    let statuses = statuses(&h);
     // Before the stop the finger was active, moving and pushing.
     let before = statuses
         .iter()
@@ -68,6 +59,17 @@ fn run(corruption: SetpointCorruption) -> (u64, u64, Harness) {
         .filter(|(t, _)| *t >= braked_at)
         .all(|(_, s)| s.state() == FingerState::Braked && s.force() == 0.0));
     (last_valid, braked_at, h)
+}
+
+/// The finger's statuses on the bus, decoded, with their times.
+fn statuses(h: &Harness) -> Vec<(u64, FingerStatus)> {
+    h.with_id(FingerStatus::IDS[FINGER])
+        .into_iter()
+        .map(|(t, f)| {
+            let s = FingerStatus::decode(f.raw_id(), f.data()).expect("valid status");
+            (t, s)
+        })
+        .collect()
 }
 
 fn assert_brake_window(last_valid: u64, braked_at: u64) {
@@ -334,16 +336,7 @@ fn a_short_estop_resumes_nothing_until_a_new_epoch() {
             .all(|(_, a)| *a == stopped),
         "the finger moved after the RELEASE, before a new epoch"
     );
-    let statuses: Vec<(u64, FingerStatus)> = h
-        .with_id(FingerStatus::IDS[FINGER])
-        .into_iter()
-        .map(|(t, f)| {
-            (
-                t,
-                FingerStatus::decode(f.raw_id(), f.data()).expect("valid"),
-            )
-        })
-        .collect();
+    let statuses = statuses(&h);
     let during = |lo: u64, hi: u64| statuses.iter().filter(move |(t, _)| (lo..hi).contains(t));
     assert!(during(301_000, 310_000).all(|(_, s)| s.state() == FingerState::Braked));
     // Released: stopped, not braked; 150 ms after the last frame it followed (250 ms: the
@@ -397,16 +390,7 @@ fn a_second_sender_interleaving_its_counters_moves_nothing_and_the_finger_brakes
         }
         mc.poll(t, &mut mc_ep);
     });
-    let statuses: Vec<(u64, FingerStatus)> = h
-        .with_id(FingerStatus::IDS[FINGER])
-        .into_iter()
-        .map(|(t, f)| {
-            (
-                t,
-                FingerStatus::decode(f.raw_id(), f.data()).expect("valid"),
-            )
-        })
-        .collect();
+    let statuses = statuses(&h);
     let before = statuses
         .iter()
         .rev()

@@ -196,54 +196,59 @@ impl FingerNode {
         }
     }
 
-    fn on_frame(&mut self, now_us: u64, frame: &hand_dbc::CanFrame) {
-        let id = std_id(frame);
-        if id == FingerSetpoint::IDS[self.finger] {
-            let status = self.checker.check_frame(Some(frame));
-            let decoded = messages::FingerSetpoint::decode(id, frame.data());
-            match (status, decoded) {
-                (E2eStatus::Ok, Ok(sp))
-                    if self.gate.admit(sp.mode(), sp.epoch()) == Verdict::Ignore =>
-                {
-                    self.stale_since_status = true;
-                }
-                (E2eStatus::Ok, Ok(sp)) => {
-                    self.cmd = Command {
-                        mode: match sp.mode() {
-                            messages::FingerMode::Disabled => FingerMode::Disabled,
-                            messages::FingerMode::Active => FingerMode::Active,
-                            messages::FingerMode::Hold => FingerMode::Hold,
-                            messages::FingerMode::SafeStop => FingerMode::SafeStop,
-                        },
-                        force_n: sp.force(),
-                        velocity_rad_s: sp.velocity(),
-                    };
-                    self.last_valid_us = Some(now_us);
-                    self.ever_valid = true;
-                    self.timed_out = false;
-                }
-                // A correct frame of a stream that is resynchronising (Profile 1's sync
-                // counter: after a counter jump, the next two in-sequence frames are not used).
-                // A jump is a restarted sender, lost frames or a second sender interleaving
-                // with the first; until two consecutive frames prove one sender again, nothing
-                // moves the finger, feeds the watchdog or opens an epoch. A SAFE_STOP still
-                // stops it: stopping is always safe, whoever asks.
-                (E2eStatus::Sync | E2eStatus::WrongSequence, Ok(sp))
-                    if sp.mode() == messages::FingerMode::SafeStop =>
-                {
-                    self.stop_command();
-                    if status == E2eStatus::WrongSequence {
-                        self.e2e_errors += 1;
-                        self.e2e_errors_since_status = true;
-                    }
-                }
-                // In sequence, not yet trusted: not an error.
-                (E2eStatus::Sync, Ok(_)) => {}
-                _ => {
+    /// A FINGER_SETPOINT of this finger: E2E, then the epoch gate, then the command.
+    fn on_setpoint(&mut self, now_us: u64, id: u32, frame: &hand_dbc::CanFrame) {
+        let status = self.checker.check_frame(Some(frame));
+        let decoded = messages::FingerSetpoint::decode(id, frame.data());
+        match (status, decoded) {
+            (E2eStatus::Ok, Ok(sp))
+                if self.gate.admit(sp.mode(), sp.epoch()) == Verdict::Ignore =>
+            {
+                self.stale_since_status = true;
+            }
+            (E2eStatus::Ok, Ok(sp)) => {
+                self.cmd = Command {
+                    mode: match sp.mode() {
+                        messages::FingerMode::Disabled => FingerMode::Disabled,
+                        messages::FingerMode::Active => FingerMode::Active,
+                        messages::FingerMode::Hold => FingerMode::Hold,
+                        messages::FingerMode::SafeStop => FingerMode::SafeStop,
+                    },
+                    force_n: sp.force(),
+                    velocity_rad_s: sp.velocity(),
+                };
+                self.last_valid_us = Some(now_us);
+                self.ever_valid = true;
+                self.timed_out = false;
+            }
+            // A correct frame of a stream that is resynchronising (Profile 1's sync
+            // counter: after a counter jump, the next two in-sequence frames are not used).
+            // A jump is a restarted sender, lost frames or a second sender interleaving
+            // with the first; until two consecutive frames prove one sender again, nothing
+            // moves the finger, feeds the watchdog or opens an epoch. A SAFE_STOP still
+            // stops it: stopping is always safe, whoever asks.
+            (E2eStatus::Sync | E2eStatus::WrongSequence, Ok(sp))
+                if sp.mode() == messages::FingerMode::SafeStop =>
+            {
+                self.stop_command();
+                if status == E2eStatus::WrongSequence {
                     self.e2e_errors += 1;
                     self.e2e_errors_since_status = true;
                 }
             }
+            // In sequence, not yet trusted: not an error.
+            (E2eStatus::Sync, Ok(_)) => {}
+            _ => {
+                self.e2e_errors += 1;
+                self.e2e_errors_since_status = true;
+            }
+        }
+    }
+
+    fn on_frame(&mut self, now_us: u64, frame: &hand_dbc::CanFrame) {
+        let id = std_id(frame);
+        if id == FingerSetpoint::IDS[self.finger] {
+            self.on_setpoint(now_us, id, frame);
         } else if id == HandEstop::ID {
             // Several senders interleave counters on HAND_ESTOP (hand.dbc): only the CRC
             // decides whether to believe it.
