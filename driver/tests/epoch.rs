@@ -80,11 +80,24 @@ fn stale_is_ignored_and_current_moves(r: &mut Rig, old: u16) {
         n0 + 1,
         "the controller counts the stale frame it ignored"
     );
-    // handd's next frame repeats the injected counter (rejected by E2E); the one after is
-    // in sequence again: inject the control after it.
-    r.run_until(t + 2 * TICK);
+    // The stale frame was a second sender in handd's stream: handd's next frame repeats its
+    // counter, and Profile 1's sync counter holds back the two after it (150 ms without a
+    // trusted setpoint), so the controller brakes by itself and retires handd's epoch too;
+    // handd's safe stops then bind a new one. The control goes in the epoch the controller
+    // follows once handd's stream is trusted again.
+    let settled = (t + 1_000_000).div_ceil(TICK) * TICK + 1_000;
+    r.run_until(settled);
+    let current = r.runner.engine().epoch(FINGER);
+    let gate = r.world.fingers().nth(FINGER).expect("finger").epoch_gate();
+    assert_eq!(
+        gate.bound(),
+        Some(current),
+        "the controller follows handd's epoch"
+    );
+    let p0 = angle(r);
+    let v = if p0 < 0.8 { 4.0 } else { -4.0 };
     inject(r, current, v);
-    r.run_until(t + 2 * TICK + 40_000);
+    r.run_until(settled + 40_000);
     let moved = (angle(r) - p0).abs();
     println!("stale frame ignored; the control in epoch {current:#06x} moved {moved:.3} rad");
     assert!(
