@@ -11,16 +11,17 @@
 //! [`RxTimes`] re-measures the offset at every read (two clock reads, no system call on vDSO
 //! platforms). When it moved by more than [`STEP_US`] the wall clock was stepped: the new offset
 //! applies from then on and the step is counted. A frame stamped before the step but read after
-//! it would map to a time far from the truth, an hour early or late. Receive times never go
-//! back, so one mapped before the last time handed out takes that time. One mapped into the
-//! future (a backward step) also takes the last time handed out, not now: it was received
-//! before now and after that frame, and now is past the deadline of the tick that reads its
-//! backlog, so a frame placed at now is held back for the next tick, which holds back the
-//! next one again: one frame per tick while the backlog lasts, SAFE for seconds (the VM drill
-//! found this). A time within [`STEP_US`] of now is only the jitter of the two clock reads and
-//! is clamped to now. Such a frame's time is off by at most the time it waited in the socket, a
-//! tick at most; every frame after it is exact again. Slow NTP slewing moves the offset by microseconds per second
-//! and is followed without a step being counted.
+//! it would map an hour early or late on the new offset; it was stamped on the old one, which is
+//! kept, so it maps exactly on that. Which offset a frame was stamped on is told by where it
+//! lands: receive times never go back and no frame is received after it is read, so a time
+//! before the last one handed out or after now (beyond [`STEP_US`] of jitter either way) is the
+//! wrong offset. Exact times matter: a backlog placed at the last time handed out looked like
+//! 50 ms without EMG to the tick that read it (an EMG-silence fault and half a second of safe
+//! stops after a -1 h step, the VM drill found), and one placed at the read time, past that
+//! tick's deadline, was held back one frame per tick (SAFE for seconds). A frame that fits
+//! neither offset (two steps within one backlog) takes the last time handed out. A time within [`STEP_US`] of the range is only the jitter of the two clock reads and
+//! is clamped into it. Slow NTP slewing moves the offset by microseconds per second and is
+//! followed without a step being counted.
 
 /// An offset change larger than this is a step of the wall clock, µs.
 pub const STEP_US: i128 = 5_000;
@@ -30,6 +31,8 @@ pub const STEP_US: i128 = 5_000;
 pub struct RxTimes {
     /// Wall clock minus monotonic clock, µs, as last measured.
     offset_us: Option<i128>,
+    /// The offset before the last step: frames stamped before it, read after it, map on it.
+    before_step_us: Option<i128>,
     /// The last time handed out, µs on the monotonic clock.
     last_us: u64,
     /// Wall-clock steps seen.
@@ -43,25 +46,29 @@ impl RxTimes {
     /// the wall clock) and read when the clocks read `wall_now_us` and `mono_now_us`.
     pub fn map(&mut self, stamp_wall_us: i128, wall_now_us: i128, mono_now_us: u64) -> u64 {
         let offset_now = wall_now_us - i128::from(mono_now_us);
-        let offset = match self.offset_us {
-            Some(o) if (offset_now - o).abs() > STEP_US => {
+        if let Some(o) = self.offset_us {
+            let step = offset_now - o;
+            if step.abs() > STEP_US {
                 self.steps += 1;
-                if (offset_now - o).abs() > self.largest_step_us.abs() {
-                    self.largest_step_us = offset_now - o;
+                if step.abs() > self.largest_step_us.abs() {
+                    self.largest_step_us = step;
                 }
-                offset_now
+                self.before_step_us = Some(o);
             }
-            // Slewing (or nothing): follow it without counting.
-            Some(_) | None => offset_now,
-        };
-        self.offset_us = Some(offset);
-        let mapped = (stamp_wall_us - offset).clamp(0, i128::from(u64::MAX)) as u64;
+            // Otherwise slewing (or nothing): followed without counting.
+        }
+        self.offset_us = Some(offset_now);
         let earliest = self.last_us.min(mono_now_us);
-        let t = if u128::from(mapped) > u128::from(mono_now_us) + STEP_US as u128 {
-            // Stamped before a backward step: at the last frame's time, inside this tick.
-            earliest
-        } else {
-            mapped.clamp(earliest, mono_now_us)
+        let fits = |offset: i128| {
+            let t = stamp_wall_us - offset;
+            let ok = t >= i128::from(earliest) - STEP_US && t <= i128::from(mono_now_us) + STEP_US;
+            ok.then_some(t)
+        };
+        let t = match fits(offset_now).or_else(|| self.before_step_us.and_then(fits)) {
+            Some(t) => t.clamp(i128::from(earliest), i128::from(mono_now_us)) as u64,
+            // Stamped on neither offset: at the last frame's time, inside the tick that reads
+            // it (at now, past that tick's deadline, each such frame would hold the next back).
+            None => earliest,
         };
         self.last_us = t;
         t
@@ -114,11 +121,15 @@ mod tests {
         );
         // The wall clock goes back an hour at monotonic 1.02 s. Frames stamped before the
         // step, read after it (a tick with deadline 1.025 s reading its backlog at 1.03 s):
-        // at the last frame's time, not an hour in the future, and not at the read time either,
-        // which is past the tick's deadline and would hold each back to the next tick.
+        // at their own times, on the offset they were stamped on; not an hour in the future,
+        // not at the read time (past the tick's deadline: each would hold the next back) and
+        // not at the last frame's time (50 ms without EMG to that tick).
         let wall = |mono: i128| WALL0 + mono - HOUR;
         for stamped in [1_010_000, 1_015_000, 1_019_000] {
-            assert_eq!(r.map(WALL0 + stamped, wall(1_030_000), 1_030_000), 999_000);
+            assert_eq!(
+                r.map(WALL0 + stamped, wall(1_030_000), 1_030_000),
+                stamped as u64
+            );
         }
         // Frames stamped after the step map exactly.
         assert_eq!(
@@ -137,17 +148,43 @@ mod tests {
             999_000
         );
         let wall = |mono: i128| WALL0 + mono + HOUR;
-        // Stamped before the step: an hour in the past on the new offset; clamped to the last
-        // time handed out, never before it.
+        // Stamped before the step: an hour in the past on the new offset, exact on the old.
         assert_eq!(
             r.map(WALL0 + 1_010_000, wall(1_030_000), 1_030_000),
-            999_000
+            1_010_000
         );
         assert_eq!(
             r.map(wall(1_040_000), wall(1_040_500), 1_040_500),
             1_040_000
         );
         assert_eq!(r.steps(), 1);
+    }
+
+    #[test]
+    fn a_frame_that_fits_neither_offset_takes_the_last_time_handed_out() {
+        let mut r = RxTimes::default();
+        assert_eq!(
+            r.map(WALL0 + 999_000, WALL0 + 1_000_000, 1_000_000),
+            999_000
+        );
+        // Two steps (-1 h, then +3 h) before the backlog is read: the first frame was stamped
+        // on the offset before both, which neither kept offset gives.
+        let _ = r.map(
+            WALL0 - HOUR + 1_005_000,
+            WALL0 - HOUR + 1_005_100,
+            1_005_100,
+        );
+        let wall = |mono: i128| WALL0 + mono + 2 * HOUR;
+        assert_eq!(
+            r.map(WALL0 + 1_001_000, wall(1_030_000), 1_030_000),
+            1_005_000
+        );
+        // In the future on every offset: the same, never the read time.
+        assert_eq!(
+            r.map(wall(1_030_000) + HOUR, wall(1_031_000), 1_031_000),
+            1_005_000
+        );
+        assert_eq!(r.steps(), 2);
     }
 
     #[test]

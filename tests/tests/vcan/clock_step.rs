@@ -88,7 +88,7 @@ fn field_clock_steps_keep_handd_running_and_reacting() {
             st.faults,
             st.bus.counters.clock_steps
         );
-        if st.state != "RUNNING" {
+        if st.state != "RUNNING" || stopped > 0 {
             rig.handd.terminate(Duration::from_secs(5));
             print_ticks_around_first_stop(&tape);
         }
