@@ -86,6 +86,7 @@ fn meta(channels: usize) -> SessionMeta {
             trial(2, TrialKind::Flexion, 1500, 3000),
         ],
         reference: None,
+        recorded_utc: None,
     }
 }
 

@@ -103,6 +103,15 @@ fn metadata_round_trips() {
     let text = meta.to_toml();
     let back = SessionMeta::parse(&text, std::path::Path::new("x/session.toml")).unwrap();
     assert_eq!(back, meta);
+    // With the date the recorder writes: 1.7e9 s after the epoch.
+    let dated = meta.recorded_at(1_700_000_000);
+    let text = dated.to_toml();
+    assert!(
+        text.contains("recorded_utc = \"2023-11-14T22:13:20Z\""),
+        "{text}"
+    );
+    let back = SessionMeta::parse(&text, std::path::Path::new("x/session.toml")).unwrap();
+    assert_eq!(back, dated);
 }
 
 fn parse(text: &str) -> Result<SessionMeta, SessionError> {
@@ -131,6 +140,17 @@ fn bad_metadata_is_refused_with_a_clear_message() {
     // End before start.
     let e = parse(&format!("{HEAD}[[trial]]\nid = 1\nfinger = \"all\"\nkind = \"rest\"\nrepetition = 1\nstart_us = 10\nend_us = 9\n")).unwrap_err().to_string();
     assert!(e.contains("not after start"), "{e}");
+    // A date that is not a UTC time.
+    let t = "[[trial]]\nid = 1\nfinger = 1\nkind = \"flexion\"\nrepetition = 1\nstart_us = 0\nend_us = 9\n";
+    let e = parse(&format!(
+        "recorded_utc = \"2026-13-01T00:00:00Z\"\n{HEAD}{t}"
+    ))
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("recorded_utc") && e.contains("2026-13-01"),
+        "{e}"
+    );
     // Duplicate ids.
     let t = "[[trial]]\nid = 1\nfinger = \"index\"\nkind = \"flexion\"\nrepetition = 1\nstart_sample = 0\nend_sample = 900\n";
     let e = parse(&format!("{HEAD}{t}{t}")).unwrap_err().to_string();

@@ -185,7 +185,9 @@ fn session_meta(trials: &[Trial], start_us: u64, mains_hz: u32) -> SessionMeta {
         mains_hz,
         ..ChainConfig::default()
     };
+    // The log's time base is the kernel's receive stamps: the wall clock.
     SessionMeta::candump(chain, FRAMES_FILE, f64::from(ADC_MAX), shifted)
+        .recorded_at(start_us / 1_000_000)
 }
 
 #[cfg(test)]
@@ -209,6 +211,8 @@ mod tests {
         assert_eq!(meta.trials.len(), 1);
         assert_eq!(meta.trials[0].start_us, 1_700_000_000_001_000);
         assert_eq!(meta.trials[0].end_us, 1_700_000_000_002_000);
+        // The log's first stamp is the calibration's date in the model file.
+        assert_eq!(meta.recorded_utc.as_deref(), Some("2023-11-14T22:13:20Z"));
     }
 
     #[test]

@@ -65,14 +65,26 @@ pub(super) fn session_id(spec: &str) -> String {
 }
 
 /// The provenance recorded in the model file: `patient` (from `--patient`), the session's id,
-/// now (UTC) as the calibration date (`session.toml` records none), and the gate findings
+/// the calibration date (when the session was recorded, `recorded`; now when the session
+/// records none, as an imported recording does: said on stderr), and the gate findings
 /// training went past. Says on stderr when no patient is recorded.
 pub(super) fn provenance(
     patient: Option<&str>,
     session: String,
+    recorded: Option<&str>,
     opts: &TrainingOpts,
     gates_bypassed: Vec<String>,
 ) -> Provenance {
+    let calibrated_utc = recorded.map_or_else(
+        || {
+            eprintln!(
+                "the session records no date (session.toml's recorded_utc): the model file \
+                 gives today's as the calibration date"
+            );
+            utc_now()
+        },
+        str::to_owned,
+    );
     if patient.is_none() {
         eprintln!(
             "no --patient: the model file records no patient id (\"unknown patient\"); \
@@ -82,7 +94,7 @@ pub(super) fn provenance(
     Provenance {
         patient: patient.map(str::to_owned),
         session,
-        calibrated_utc: utc_now(),
+        calibrated_utc,
         ignore_gates: opts.ignore_gates,
         gates_bypassed,
     }
@@ -172,6 +184,7 @@ pub fn run(a: &TrainArgs) -> Result<(), CliError> {
     let record = provenance(
         a.patient.as_deref(),
         session_id(&a.session),
+        session.meta.recorded_utc.as_deref(),
         &a.training,
         bypassed,
     );

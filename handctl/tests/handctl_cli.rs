@@ -472,6 +472,13 @@ fn train_refuses_a_reversing_model_force_records_it_and_eval_scores_the_file() {
 
     let out = train(&["--force", "--patient", "P-006"]);
     assert!(out.status.success(), "{}", text(&out.stderr));
+    // An imported session has no date: the calibration date is the training's, and train
+    // says so.
+    assert!(
+        text(&out.stderr).contains("the session records no date"),
+        "{}",
+        text(&out.stderr)
+    );
     let m = decoder::model::TrainedModel::load(&model, None).unwrap();
     // The session's id is its directory's name.
     let origin = m.provenance().expect("train records the provenance");
@@ -491,6 +498,26 @@ fn train_refuses_a_reversing_model_force_records_it_and_eval_scores_the_file() {
     assert!(
         rest.iter().all(|&r| (r / expected - 1.0).abs() < 0.1),
         "{rest:?}, expected about {expected:.2}"
+    );
+
+    // A session that records when it was recorded gives that as the calibration date.
+    let toml = session.join("session.toml");
+    let t = std::fs::read_to_string(&toml).unwrap().replacen(
+        "format_version = 1\n",
+        "format_version = 1\nrecorded_utc = \"2026-11-30T09:12:55Z\"\n",
+        1,
+    );
+    std::fs::write(&toml, t).unwrap();
+    let out = train(&["--force", "--patient", "P-006"]);
+    let e = text(&out.stderr);
+    assert!(
+        out.status.success() && !e.contains("records no date"),
+        "{e}"
+    );
+    let m = decoder::model::TrainedModel::load(&model, None).unwrap();
+    assert_eq!(
+        m.provenance().expect("provenance").calibrated_utc,
+        "2026-11-30T09:12:55Z"
     );
 
     let out = handctl(&["eval", "--model", s(&model), s(&session)]);

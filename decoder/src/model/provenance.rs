@@ -22,8 +22,9 @@ pub struct Provenance {
     pub patient: Option<String>,
     /// The calibration session: its directory's name (or the importer's description).
     pub session: String,
-    /// When the model was trained on the session, UTC, to the second: `2026-12-02T13:15:28Z`
-    /// (`session.toml` records no date of its own).
+    /// When the calibration session was recorded (its `session.toml`'s `recorded_utc`), UTC,
+    /// to the second: `2026-12-02T13:15:28Z`; when the model was trained, for a session that
+    /// records no date (an imported recording).
     pub calibrated_utc: String,
     /// Training was told to go on whatever the quality gates found (`--ignore-gates`).
     pub ignore_gates: bool,
@@ -84,7 +85,7 @@ pub fn utc_now() -> String {
 
 /// True when `t` has the shape [`utc_text`] writes, with months 01-12, days 01-31, hours
 /// 00-23, minutes and seconds 00-59 (leap seconds: up to 60).
-fn is_utc_text(t: &str) -> bool {
+pub fn is_utc_text(t: &str) -> bool {
     let b = t.as_bytes();
     if b.len() != 20 {
         return false;

@@ -209,6 +209,7 @@ fn three_dc_meta(dir: &Path, split: Split) -> Result<(SessionMeta, PathBuf), Ses
         segments,
         trials,
         reference: None,
+        recorded_utc: None,
     };
     meta.check(&index)?;
     Ok((meta, npy))

@@ -3,6 +3,8 @@
 //! ```toml
 //! format_version = 1
 //! onset_skip_ms = 0.0        # windows starting this soon after a trial's start are left out
+//! recorded_utc = "2026-12-02T13:15:28Z"  # optional: when the recording started (UTC); the
+//!                            # model file's calibration date (handctl calibrate/record write it)
 //!
 //! [chain]                    # decoder::dsp::ChainConfig; missing fields take the defaults
 //! channels = 12
@@ -36,6 +38,7 @@ use super::reference::ReferenceSpec;
 use super::trial::{FingerField, Trial, TrialKind, N_FINGERS};
 use crate::dsp::ChainConfig;
 use crate::fsio::write_atomic;
+use crate::model::provenance::{is_utc_text, utc_now, utc_text};
 
 /// The `session.toml` format this code writes and reads.
 pub const FORMAT_VERSION: u32 = 1;
@@ -95,6 +98,9 @@ pub struct SessionMeta {
     pub trials: Vec<Trial>,
     /// A force or angle recorded beside the EMG, if the import named one.
     pub reference: Option<ReferenceSpec>,
+    /// When the recording started, UTC to the second (`2026-12-02T13:15:28Z`); None when not
+    /// known (an imported recording).
+    pub recorded_utc: Option<String>,
 }
 
 #[derive(Debug, Serialize, Deserialize)]
@@ -120,6 +126,8 @@ struct SessionFile {
     format_version: u32,
     #[serde(default)]
     onset_skip_ms: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    recorded_utc: Option<String>,
     chain: ChainConfig,
     recording: RecordingSpec,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -155,7 +163,20 @@ impl SessionMeta {
             segments: Vec::new(),
             trials,
             reference: None,
+            recorded_utc: None,
         }
+    }
+
+    /// The same, recorded from `unix_s` seconds after the Unix epoch.
+    pub fn recorded_at(mut self, unix_s: u64) -> Self {
+        self.recorded_utc = Some(utc_text(unix_s));
+        self
+    }
+
+    /// The same, recorded from now.
+    pub fn recorded_now(mut self) -> Self {
+        self.recorded_utc = Some(utc_now());
+        self
     }
 
     /// Parses and checks the text of a `session.toml`; `path` is only used in messages.
@@ -205,6 +226,7 @@ impl SessionMeta {
             segments: file.segments,
             trials,
             reference: file.reference,
+            recorded_utc: file.recorded_utc,
         };
         meta.check(path)?;
         Ok(meta)
@@ -221,6 +243,14 @@ impl SessionMeta {
                     self.onset_skip_ms
                 ),
             ));
+        }
+        if let Some(t) = &self.recorded_utc {
+            if !is_utc_text(t) {
+                return Err(SessionError::invalid(
+                    path,
+                    format!("recorded_utc {t:?} is not a UTC time like \"2026-12-02T13:15:28Z\""),
+                ));
+            }
         }
         if let Some(fs) = self.recording.full_scale {
             if !(fs.is_finite() && fs > 0.0) {
@@ -305,6 +335,7 @@ impl SessionMeta {
         let file = SessionFile {
             format_version: FORMAT_VERSION,
             onset_skip_ms: self.onset_skip_ms,
+            recorded_utc: self.recorded_utc.clone(),
             chain: self.chain.clone(),
             recording: self.recording.clone(),
             reference: self.reference.clone(),

@@ -193,6 +193,7 @@ pub fn import_table(spec: &TableImport, out: &Path) -> Result<SessionMeta, Sessi
         segments,
         trials,
         reference,
+        recorded_utc: None,
     };
     let recording = Recording::load(&meta, out)?;
     Reference::load(&meta, out, recording.len())?;

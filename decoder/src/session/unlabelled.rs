@@ -55,6 +55,7 @@ impl Session {
             segments: Vec::new(),
             trials: Vec::new(),
             reference: None,
+            recorded_utc: None,
         }
     }
 

@@ -101,6 +101,7 @@ pub fn synth(trials: &[SynthTrial], seed: u64) -> (Vec<f64>, SessionMeta) {
         segments: Vec::new(),
         trials: meta_trials,
         reference: None,
+        recorded_utc: None,
     };
     (samples, meta)
 }

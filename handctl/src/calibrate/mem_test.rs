@@ -306,6 +306,10 @@ fn train_and_summarize(dir: &Path) {
     let origin = loaded
         .provenance()
         .expect("calibrate records the provenance");
+    // The calibration date is the session's (the day it began, kept through the resume).
+    let began = trained.session.meta.recorded_utc.as_deref();
+    assert!(began.is_some(), "calibrate records when the session began");
+    assert_eq!(Some(origin.calibrated_utc.as_str()), began);
     let dir_name = dir
         .file_name()
         .expect("a named directory")

@@ -47,7 +47,8 @@ impl Store {
         std::fs::write(&p, protocol.to_toml()).map_err(CalibrateError::io(&p))?;
         Ok(Store {
             dir: dir.to_path_buf(),
-            meta: SessionMeta::candump(chain, FRAMES_FILE, f64::from(ADC_MAX), Vec::new()),
+            meta: SessionMeta::candump(chain, FRAMES_FILE, f64::from(ADC_MAX), Vec::new())
+                .recorded_now(),
         })
     }
 
@@ -83,6 +84,8 @@ impl Store {
                 ));
             }
             meta.trials = old.trials;
+            // The calibration's date is when it began, not when it was resumed.
+            meta.recorded_utc = old.recorded_utc;
         }
         for (i, t) in meta.trials.iter().enumerate() {
             if t.id as usize != i + 1 {

@@ -56,6 +56,7 @@ pub fn train_session(
     let origin = provenance(
         patient,
         crate::train::session_id(&dir.display().to_string()),
+        session.meta.recorded_utc.as_deref(),
         opts,
         bypassed,
     );
