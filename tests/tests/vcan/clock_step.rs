@@ -58,11 +58,6 @@ impl Drop for SteppedClock {
 }
 
 #[test]
-// Fixed on 2026-12-02 (driver/src/rx_times.rs: a frame stamped before a backward step takes
-// the last frame's time; the drill's tape printout showed one frame read per tick before), but
-// the fix has not yet passed this drill in the VM: run it with
-// `VCAN_ARGS="--include-ignored clock_step" scripts/vm/run`, then remove this mark.
-#[ignore = "fix in rx_times.rs not yet run in the VM (issue 30 item 5)"]
 fn field_clock_steps_keep_handd_running_and_reacting() {
     let tape = std::env::temp_dir().join("clock-step.tape");
     let tape_arg = tape.display().to_string();
