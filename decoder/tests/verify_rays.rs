@@ -287,9 +287,10 @@ fn the_polynomials_are_the_model() {
         let mut v = RayVerifier::exact(&model).unwrap();
         for _ in 0..20 {
             let f = random_features(&mut rng, n_in, false);
-            let RayCurves::Polynomials(p, None) = v.curves(&f) else {
+            let RayCurves::Polynomials(p, stage) = v.curves(&f) else {
                 panic!("a {kind} model verifies exactly");
             };
+            assert!(stage.is_identity(), "no rest stage, every direction taught");
             for _ in 0..10 {
                 let k: f64 = rng.gen_range(0.0..=1.0);
                 let y = v.output_at(&f, k);

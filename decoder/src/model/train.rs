@@ -435,5 +435,7 @@ pub fn train(
     let envelope = super::Envelope::fit(nf, (0..data.len()).map(|i| data.row(i)))?;
     let trained = TrainedModel::new(model, *spec, normalizer, data.chain().clone(), summary)?
         .with_envelope(Some(envelope))?;
-    Ok(super::rest::with_fitted_rest(trained, data, cfg.rest)?)
+    let trained = super::rest::with_fitted_rest(trained, data, cfg.rest)?;
+    // A direction no label taught is held at 0 (issue 25 item 4).
+    Ok(trained.with_taught(super::Taught::of_dataset(data)))
 }
