@@ -124,9 +124,10 @@ fn run_saved(a: &EvalArgs, path: &Path) -> Result<(), CliError> {
     let icfg = InterpolationConfig::default();
     let e = score(a, &model, &test, &icfg)?;
     print_tables(a, &[e], &icfg);
-    let r = super::verify::report(&model, &session, &test, DEFAULT_TOLERANCE)?;
+    let (r, beyond) = super::verify::report(&model, &session, &test, DEFAULT_TOLERANCE)?;
     println!("\nEffort rays of {}:", a.session);
     print!("{r}");
+    print!("{beyond}");
     Ok(())
 }
 

@@ -22,8 +22,9 @@
 //! are sampled at [`super::SAMPLED_POINTS`] efforts over the same interval.
 //!
 //! Per ray and finger: the worst reversal against the trial's direction, and the overshoot, how
-//! far `dir·y` rises above `max(1, dir·y(1))` (the larger of full scale and the window's own
-//! full-effort output), both against the tolerance.
+//! far `dir·y` rises above the trial's full-effort value for that finger: the larger of full
+//! scale (1) and the largest `dir·y(1)` of the trial's windows (what the calibration's own
+//! strongest window gave), both against the tolerance.
 
 use std::fmt;
 
@@ -57,7 +58,7 @@ pub struct BeyondEntry {
     pub reversing_beyond_only: usize,
     /// The worst reversal (efforts in the ray's own units, `0..K`).
     pub worst: Reversal,
-    /// Rays whose output rises above `max(1, dir·y(1))` by more than the tolerance.
+    /// Rays whose output rises above the trial's full-effort value by more than the tolerance.
     pub overshooting: usize,
     /// The largest overshoot, label units.
     pub worst_overshoot: f64,
@@ -67,6 +68,8 @@ pub struct BeyondEntry {
     pub not_held: usize,
     /// The smallest edge `k_e` among the rays (`K` or more: never clipped before `K`).
     pub lowest_edge: f64,
+    /// The trial's full-effort value for the finger: `max(1, largest dir·y(1))`.
+    pub full_effort: f64,
 }
 
 /// The check of one model on `[0, K]` along every calibration ray.
@@ -132,7 +135,10 @@ impl BeyondReport {
 struct RayOutcome {
     reversal: Reversal,
     reversal_unit: f64,
-    overshoot: f64,
+    /// Largest `dir·y` on `[0, K]`.
+    peak: f64,
+    /// `dir·y(1)`.
+    full: f64,
 }
 
 /// Checks every flexion and extension window's ray on `[0, k_max]` for every finger its trial
@@ -150,6 +156,8 @@ pub fn verify_beyond(
     }
     let mut entries: Vec<BeyondEntry> = Vec::new();
     let mut scaled = vec![0.0; verifier.n_inputs()];
+    // (entry, peak) per ray and finger: the overshoot needs every ray's full effort first.
+    let mut peaks: Vec<(usize, f64)> = Vec::new();
     for (i, label) in windows.labels.iter().enumerate() {
         let fingers: Vec<usize> = (0..N_FINGERS)
             .filter(|&f| label.mask[f] && label.targets[f] != 0.0)
@@ -199,12 +207,18 @@ pub fn verify_beyond(
             if o.reversal.amount > e.worst.amount || e.rays == 1 {
                 e.worst = o.reversal;
             }
-            e.overshooting += usize::from(o.overshoot > tolerance);
-            e.worst_overshoot = e.worst_overshoot.max(o.overshoot);
+            e.full_effort = e.full_effort.max(o.full);
+            peaks.push((at, o.peak));
             e.resting += usize::from(rest_from.is_some());
             e.not_held += usize::from(!held_ok);
             e.lowest_edge = e.lowest_edge.min(edge);
         }
+    }
+    for (at, peak) in peaks {
+        let e = &mut entries[at];
+        let over = (peak - e.full_effort).max(0.0);
+        e.overshooting += usize::from(over > tolerance);
+        e.worst_overshoot = e.worst_overshoot.max(over);
     }
     Ok(BeyondReport {
         method: verifier.method(),
@@ -303,7 +317,8 @@ fn ray_outcome(
             RayOutcome {
                 reversal: r,
                 reversal_unit: unit,
-                overshoot: (peak - full.max(1.0)).max(0.0),
+                peak,
+                full,
             }
         }
         None => {
@@ -323,7 +338,8 @@ fn ray_outcome(
             RayOutcome {
                 reversal: largest_drop(&points, dir, Method::Sampled(n)),
                 reversal_unit: largest_drop(&unit, dir, Method::Sampled(n)).amount,
-                overshoot: (peak - full.max(1.0)).max(0.0),
+                peak,
+                full,
             }
         }
     }
@@ -343,6 +359,7 @@ impl BeyondEntry {
             resting: 0,
             not_held: 0,
             lowest_edge: f64::INFINITY,
+            full_effort: 1.0,
         }
     }
 }
@@ -386,7 +403,7 @@ impl fmt::Display for BeyondReport {
         writeln!(
             f,
             "{} rays checked to effort {}: {} reverse by more than {} (worst {worst:.4}; {} of \
-             them only beyond effort 1), {} overshoot full scale, {} go to rest (implausible \
+             them only beyond effort 1), {} overshoot their trial's full effort, {} go to rest (implausible \
              shape), {} not held by the predictor",
             self.rays(),
             self.k_max,
