@@ -7,8 +7,8 @@
 use std::path::Path;
 
 use decoder::eval::{
-    direction_table, evaluate_model, interpolation_csv, interpolation_table, roc_csv, write_csv,
-    InterpolationConfig, ModelEvaluation,
+    direction_table, evaluate_model, interpolation_csv, interpolation_table, roc_csv, stress,
+    stress_table, write_csv, InterpolationConfig, ModelEvaluation, StressReport,
 };
 use decoder::model::verify::{describe_verification, DEFAULT_TOLERANCE};
 use decoder::model::TrainedModel;
@@ -123,7 +123,12 @@ fn run_saved(a: &EvalArgs, path: &Path) -> Result<(), CliError> {
     );
     let icfg = InterpolationConfig::default();
     let e = score(a, &model, &test, &icfg)?;
+    let reports = vec![(
+        model.summary().kind.name().to_string(),
+        stress(&model, &test),
+    )];
     print_tables(a, &[e], &icfg);
+    print_robustness(a, &reports);
     let (r, beyond) = super::verify::report(&model, &session, &test, DEFAULT_TOLERANCE)?;
     println!("\nEffort rays of {}:", a.session);
     print!("{r}");
@@ -154,13 +159,34 @@ pub fn run(a: &EvalArgs) -> Result<(), CliError> {
     );
     let icfg = InterpolationConfig::default();
     let mut evals: Vec<ModelEvaluation> = Vec::new();
+    let mut reports = Vec::new();
     for &kind in &a.models {
         let model = fit(kind, &data, &a.training)?;
         println!("trained {}", describe(&model));
         evals.push(score(a, &model, &test_w, &icfg)?);
+        reports.push((kind.name().to_string(), stress(&model, &test_w)));
     }
     print_tables(a, &evals, &icfg);
+    print_robustness(a, &reports);
     Ok(())
+}
+
+/// Beyond the calibration (issue 25): per model, the test windows the envelope moved back or
+/// found implausible and the raw output's range; with `--stress`, the stress table.
+fn print_robustness(a: &EvalArgs, reports: &[(String, StressReport)]) {
+    println!("\nBeyond the calibration, on the test windows as recorded:");
+    for (name, r) in reports {
+        let x1 = &r.gains[0];
+        println!(
+            "  {name}: {} of {} windows beyond the calibration's envelope (moved back), {} \
+             implausible (rest); raw output in [{:.3}, {:.3}]",
+            x1.beyond, x1.windows, x1.implausible, x1.range.0, x1.range.1
+        );
+    }
+    if a.stress {
+        println!();
+        print!("{}", stress_table(reports));
+    }
 }
 
 /// What `--plots` writes in this build.
