@@ -218,6 +218,34 @@ fn mlp_and_cnn_are_verified_by_dense_sampling_and_say_so() {
             )),
             "{kind}: {text}"
         );
+        // Beyond full effort too: sampled over [0, 10], said so; with an envelope at the
+        // window itself the output past effort 1 is the predictor's at 1.
+        let features = windows.features.clone();
+        let held = model
+            .clone()
+            .with_envelope(Some(decoder::model::Envelope::try_new(features).unwrap()))
+            .unwrap();
+        let mut v = RayVerifier::new(&held);
+        let b = decoder::model::verify::verify_beyond(
+            &mut v,
+            &windows,
+            &trials,
+            DEFAULT_TOLERANCE,
+            decoder::model::verify::BEYOND_EFFORT,
+        )
+        .unwrap();
+        assert_eq!(b.method, Method::Sampled(SAMPLED_POINTS), "{kind}");
+        assert_eq!((b.rays(), b.not_held()), (report.rays(), 0), "{kind}: {b}");
+        assert!(b.to_string().contains("SAMPLED"), "{kind}: {b}");
+        assert!(b
+            .entries
+            .iter()
+            .all(|e| (e.lowest_edge - 1.0).abs() < 1e-12));
+        assert_eq!(
+            b.reversing(),
+            report.reversing(),
+            "{kind}: nothing new past 1"
+        );
     }
 }
 
