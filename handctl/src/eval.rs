@@ -8,7 +8,8 @@ use std::path::Path;
 
 use decoder::eval::{
     direction_table, evaluate_model, interpolation_csv, interpolation_table, roc_csv, stress,
-    stress_table, write_csv, InterpolationConfig, ModelEvaluation, StressReport,
+    stress_table, stress_transients, write_csv, InterpolationConfig, ModelEvaluation, StressReport,
+    StressRow, TRANSIENT_GAIN, TRANSIENT_MS,
 };
 use decoder::model::verify::{describe_verification, DEFAULT_TOLERANCE};
 use decoder::model::TrainedModel;
@@ -127,8 +128,13 @@ fn run_saved(a: &EvalArgs, path: &Path) -> Result<(), CliError> {
         model.summary().kind.name().to_string(),
         stress(&model, &test),
     )];
+    let transients = if a.stress {
+        vec![stress_transients(&model, &session)?]
+    } else {
+        Vec::new()
+    };
     print_tables(a, &[e], &icfg);
-    print_robustness(a, &reports);
+    print_robustness(a, &reports, &transients);
     let (r, beyond) = super::verify::report(&model, &session, &test, DEFAULT_TOLERANCE)?;
     println!("\nEffort rays of {}:", a.session);
     print!("{r}");
@@ -158,22 +164,34 @@ pub fn run(a: &EvalArgs) -> Result<(), CliError> {
         }
     );
     let icfg = InterpolationConfig::default();
+    // The transients go into a test recording's signal: a separate test session only.
+    let test_session = match (&a.test, a.stress) {
+        (Some(spec), true) => Some(Session::open_spec(spec)?),
+        _ => None,
+    };
     let mut evals: Vec<ModelEvaluation> = Vec::new();
     let mut reports = Vec::new();
+    let mut transients = Vec::new();
     for &kind in &a.models {
         let model = fit(kind, &data, &a.training)?;
         println!("trained {}", describe(&model));
         evals.push(score(a, &model, &test_w, &icfg)?);
         reports.push((kind.name().to_string(), stress(&model, &test_w)));
+        if let Some(ts) = &test_session {
+            transients.push(stress_transients(&model, ts)?);
+        }
     }
     print_tables(a, &evals, &icfg);
-    print_robustness(a, &reports);
+    print_robustness(a, &reports, &transients);
+    if a.stress && test_session.is_none() {
+        println!("(transients in the signal need a test session: --test)");
+    }
     Ok(())
 }
 
 /// Beyond the calibration (issue 25): per model, the test windows the envelope moved back or
 /// found implausible and the raw output's range; with `--stress`, the stress table.
-fn print_robustness(a: &EvalArgs, reports: &[(String, StressReport)]) {
+fn print_robustness(a: &EvalArgs, reports: &[(String, StressReport)], transients: &[StressRow]) {
     println!("\nBeyond the calibration, on the test windows as recorded:");
     for (name, r) in reports {
         let x1 = &r.gains[0];
@@ -186,6 +204,24 @@ fn print_robustness(a: &EvalArgs, reports: &[(String, StressReport)]) {
     if a.stress {
         println!();
         print!("{}", stress_table(reports));
+    }
+    if !transients.is_empty() {
+        println!(
+            "\nTransients in the signal: one channel at x{TRANSIENT_GAIN} for {TRANSIENT_MS} ms in \
+             the middle of every movement trial, the windows overlapping one (worst channel):"
+        );
+    }
+    for ((name, _), r) in reports.iter().zip(transients) {
+        println!(
+            "  {name}: {:.2}% of {} movement finger-windows the wrong way, |y| up to {:.3}, {} \
+             of {} windows implausible (rest); {}",
+            r.wrong_percent(),
+            r.movement,
+            r.max_abs,
+            r.implausible,
+            r.windows,
+            r.condition
+        );
     }
 }
 

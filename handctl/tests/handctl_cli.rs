@@ -98,6 +98,15 @@ fn import_train_and_eval_on_the_3dc_proxy() {
             "{o}"
         );
     }
+    assert!(o.contains("Transients in the signal"), "{o}");
+    for name in ["resdd", "ln"] {
+        assert!(
+            o.lines().any(|l| l.starts_with(&format!("  {name}: "))
+                && l.contains("movement finger-windows the wrong way")
+                && l.contains("for 200 ms")),
+            "{o}"
+        );
+    }
     for condition in ["x1.5 ", "x2 ", "x3 ", "x5 ", "worst channel at x10"] {
         assert!(
             o.lines().any(|l| l.starts_with(condition)),

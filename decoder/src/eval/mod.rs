@@ -35,7 +35,8 @@ pub use interpolation::{
 pub use plot::{interpolation_png, roc_png};
 pub use stats::{average_ranks, linear_fit, pearson, spearman, LinearFit};
 pub use stress::{
-    stress, stress_table, StressReport, StressRow, STRESS_GAINS, TRANSIENT_GAIN, WRONG_WAY,
+    stress, stress_table, stress_transients, StressReport, StressRow, STRESS_GAINS, TRANSIENT_GAIN,
+    TRANSIENT_MS, WRONG_WAY,
 };
 pub use table::{direction_table, interpolation_table};
 pub use tracking::{tracking_metrics, TrackingMetrics, MAPE_MIN_TARGET};

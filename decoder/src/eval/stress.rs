@@ -10,6 +10,12 @@
 //!   Every window is taken as inside such a transient, channel by channel: the worst case of a
 //!   transient that may come at any time, reported for the worst channel.
 //!
+//! - **Transient in the signal** ([`stress_transients`], needs the session itself): one
+//!   channel's raw samples at [`TRANSIENT_GAIN`] times for [`TRANSIENT_MS`] in the middle of
+//!   every movement trial, the recording then run through the signal chain as recorded (the
+//!   filters' own response to the step included), and only the windows that overlap a burst
+//!   counted: P7's transient as it would reach the decoder.
+//!
 //! Each condition runs through the model's [`crate::model::Predictor`] (envelope, plausibility
 //! check, output stage: the daemon's path) and counts the movement finger-windows pointing the
 //! wrong way (a finger whose trial moves it, output clamped to [-1, 1] beyond
@@ -19,12 +25,14 @@
 use super::interpolation::scale_features;
 use crate::dsp::FEATURES_PER_CHANNEL;
 use crate::model::{TrainedModel, N_FINGERS};
-use crate::session::LabelledWindows;
+use crate::session::{LabelledWindows, Session, SessionError, TrialKind, WindowOptions};
 
 /// The gains replayed: x1 (the recording as it is) to x5.
 pub const STRESS_GAINS: [f64; 5] = [1.0, 1.5, 2.0, 3.0, 5.0];
 /// One channel's level in a transient, times its own.
 pub const TRANSIENT_GAIN: f64 = 10.0;
+/// Length of a transient injected in the signal, ms (P7's last about 200 ms).
+pub const TRANSIENT_MS: f64 = 200.0;
 /// A finger points the wrong way beyond this much against its trial's direction.
 pub const WRONG_WAY: f64 = 0.2;
 
@@ -151,6 +159,69 @@ pub fn stress(model: &TrainedModel, windows: &LabelledWindows) -> StressReport {
         gains,
         worst_transient: worst.expect("at least one channel"),
     }
+}
+
+/// `model` on `session` (the test recording) with, channel by channel, a transient in the
+/// signal in every movement trial (see the module docs): the row of the channel that fared
+/// worst (most wrong-way finger-windows; the first of equals), over the windows that overlap
+/// a burst. Errors when the session's signal cannot be windowed, or has no movement trial.
+pub fn stress_transients(
+    model: &TrainedModel,
+    session: &Session,
+) -> Result<StressRow, SessionError> {
+    let settings = session.meta.chain.validate()?;
+    let wl = settings.window_len();
+    let len = (TRANSIENT_MS * settings.sample_rate_hz() / 1000.0).round() as usize;
+    let bursts: Vec<std::ops::Range<usize>> = session
+        .meta
+        .trials
+        .iter()
+        .filter(|t| t.kind != TrialKind::Rest)
+        .map(|t| {
+            let r = session.recording.range_of(t.start_us, t.end_us);
+            let mid = (r.start + r.end) / 2;
+            mid.saturating_sub(len / 2).max(r.start)..(mid + len / 2).min(r.end)
+        })
+        .filter(|b| !b.is_empty())
+        .collect();
+    if bursts.is_empty() {
+        return Err(SessionError::Spec(format!(
+            "{}: no movement trial to inject a transient into",
+            session.name.display()
+        )));
+    }
+    let channels = session.recording.channels;
+    let mut worst: Option<StressRow> = None;
+    for c in 0..channels {
+        let mut s = session.clone();
+        for b in &bursts {
+            for i in b.clone() {
+                s.recording.samples[i * channels + c] *= TRANSIENT_GAIN;
+            }
+        }
+        let all = s.windows(&WindowOptions::default())?;
+        let mut hit = LabelledWindows {
+            n_features: all.n_features,
+            features: Vec::new(),
+            labels: Vec::new(),
+        };
+        for (i, l) in all.labels.iter().enumerate() {
+            let start = l.end_sample.saturating_sub(wl);
+            if bursts
+                .iter()
+                .any(|b| start < b.end && l.end_sample > b.start)
+            {
+                hit.features.extend_from_slice(all.row(i));
+                hit.labels.push(*l);
+            }
+        }
+        let condition = format!("channel {c} at x{TRANSIENT_GAIN} for {TRANSIENT_MS} ms");
+        let r = replay(model, &hit, &hit.features, condition);
+        if worst.as_ref().is_none_or(|w| r.wrong > w.wrong) {
+            worst = Some(r);
+        }
+    }
+    Ok(worst.expect("at least one channel"))
 }
 
 /// The reports of several models side by side: one line per condition, per model the
