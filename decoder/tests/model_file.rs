@@ -509,3 +509,69 @@ fn provenance_round_trips_and_older_files_load_as_unknown_patient() {
         .unwrap_err();
     assert!(e.to_string().contains("calibration date"), "{e}");
 }
+
+/// Issue 25 item 4: the directions the calibration taught are a required section, written only
+/// when some direction was not taught, covered by the checksum; a file without it (older, or a
+/// full calibration) loads as "both taught" and outputs what it did.
+#[test]
+fn taught_directions_round_trip_and_older_files_load_as_both_taught() {
+    use decoder::model::Taught;
+    let load = |b: &[u8]| TrainedModel::from_bytes(b, Some(&chain(2)));
+    let full = trained(ModelKind::ResDd);
+    assert!(full.taught().is_both(), "{:?}", full.taught());
+    let full_bytes = full.to_bytes().unwrap();
+    let p = split(&full_bytes);
+    assert!(
+        p.meta.get("taught").is_none(),
+        "nothing to hold, nothing written"
+    );
+    assert_eq!(load(&full_bytes).unwrap().taught(), &Taught::BOTH);
+
+    let mut taught = Taught::BOTH;
+    taught.extension = [false; 5];
+    taught.flexion[3] = false;
+    let held = full.clone().with_taught(taught);
+    let bytes = held.to_bytes().unwrap();
+    let back = load(&bytes).unwrap();
+    assert_eq!(back, held);
+    assert_eq!(back.taught(), &taught);
+    let mut p = split(&bytes);
+    assert!(p.meta["required"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|r| r == "taught"));
+    // The outputs: the held directions are 0, the others those of the full model.
+    let x = vec![0.3; back.normalizer().len()];
+    let (y, y_full) = (back.predict(&x), full.predict(&x));
+    for f in 0..5 {
+        assert_eq!(y[f], taught.hold(f, y_full[f]), "finger {f}");
+    }
+    // Covered by the checksum: one byte of the section changed and the file is refused.
+    let at = find(&bytes, b"\"taught\"");
+    let mut bad = bytes.clone();
+    bad[at + 1] ^= 0x20;
+    assert!(matches!(load(&bad), Err(FileError::BadChecksum { .. })));
+    // Present but not required: malformed (a reader must not drop it unknowingly).
+    let required: Vec<serde_json::Value> = p.meta["required"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|r| *r != "taught")
+        .cloned()
+        .collect();
+    p.meta["required"] = serde_json::Value::Array(required);
+    let e = load(&join(&p)).unwrap_err();
+    assert!(e.to_string().contains("taught"), "{e}");
+    // The older file: no section; both taught, the full model's outputs.
+    p.meta.as_object_mut().unwrap().remove("taught");
+    let old = load(&join(&p)).unwrap();
+    assert_eq!(old.taught(), &Taught::BOTH);
+    assert_eq!(old, full);
+}
+
+fn find(hay: &[u8], needle: &[u8]) -> usize {
+    hay.windows(needle.len())
+        .position(|w| w == needle)
+        .expect("present")
+}

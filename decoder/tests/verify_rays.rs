@@ -218,6 +218,34 @@ fn mlp_and_cnn_are_verified_by_dense_sampling_and_say_so() {
             )),
             "{kind}: {text}"
         );
+        // Beyond full effort too: sampled over [0, 10], said so; with an envelope at the
+        // window itself the output past effort 1 is the predictor's at 1.
+        let features = windows.features.clone();
+        let held = model
+            .clone()
+            .with_envelope(Some(decoder::model::Envelope::try_new(features).unwrap()))
+            .unwrap();
+        let mut v = RayVerifier::new(&held);
+        let b = decoder::model::verify::verify_beyond(
+            &mut v,
+            &windows,
+            &trials,
+            DEFAULT_TOLERANCE,
+            decoder::model::verify::BEYOND_EFFORT,
+        )
+        .unwrap();
+        assert_eq!(b.method, Method::Sampled(SAMPLED_POINTS), "{kind}");
+        assert_eq!((b.rays(), b.not_held()), (report.rays(), 0), "{kind}: {b}");
+        assert!(b.to_string().contains("SAMPLED"), "{kind}: {b}");
+        assert!(b
+            .entries
+            .iter()
+            .all(|e| (e.lowest_edge - 1.0).abs() < 1e-12));
+        assert_eq!(
+            b.reversing(),
+            report.reversing(),
+            "{kind}: nothing new past 1"
+        );
     }
 }
 
@@ -287,9 +315,10 @@ fn the_polynomials_are_the_model() {
         let mut v = RayVerifier::exact(&model).unwrap();
         for _ in 0..20 {
             let f = random_features(&mut rng, n_in, false);
-            let RayCurves::Polynomials(p, None) = v.curves(&f) else {
+            let RayCurves::Polynomials(p, stage) = v.curves(&f) else {
                 panic!("a {kind} model verifies exactly");
             };
+            assert!(stage.is_identity(), "no rest stage, every direction taught");
             for _ in 0..10 {
                 let k: f64 = rng.gen_range(0.0..=1.0);
                 let y = v.output_at(&f, k);
@@ -345,4 +374,78 @@ proptest! {
         prop_assert!(exact.amount >= sampled - 1e-12 * scale, "exact {exact:?}, sampled {sampled}");
         prop_assert!(exact.bound <= 1e-12 * scale, "{exact:?}");
     }
+}
+
+/// Issue 25 item 3: beyond full effort. The dipping ResDD's window at half its level
+/// (RMS 0.5, VAR 0.25) puts the dip at effort 1.05: [0, 1] passes, [0, 10] does not, unless
+/// the envelope holds the input at the edge before it. The exact result agrees with the
+/// predictor sampled densely over [0, 10], and the hold is confirmed on the predictor.
+#[test]
+fn beyond_full_effort_the_dip_is_found_unless_the_envelope_holds_the_ray_before_it() {
+    use decoder::model::verify::{verify_beyond, BEYOND_EFFORT};
+    use decoder::model::Envelope;
+    let (model, full) = dipping_resdd();
+    let half: Vec<f64> = full
+        .iter()
+        .enumerate()
+        .map(|(j, v)| v * if j == 2 { 0.25 } else { 0.5 })
+        .collect();
+    let (windows, trials) = one_window(half.clone());
+    let tol = DEFAULT_TOLERANCE;
+    let check = |m: &TrainedModel| {
+        let mut v = RayVerifier::exact(m).unwrap();
+        let unit = verify_windows(&mut v, &windows, &trials, tol).unwrap();
+        let beyond = verify_beyond(&mut v, &windows, &trials, tol, BEYOND_EFFORT).unwrap();
+        assert!(unit.passed(), "{unit}");
+        assert_eq!(beyond.rays(), unit.rays());
+        assert_eq!(beyond.not_held(), 0, "{beyond}");
+        assert_eq!(beyond.resting(), 0, "one channel is never implausible");
+        // Dense sampling of the real predictor over [0, 10] never finds more than the proof.
+        let n = 100_001;
+        let points: Vec<(f64, f64)> = (0..n)
+            .map(|i| {
+                let k = BEYOND_EFFORT * i as f64 / (n - 1) as f64;
+                (k, v.output_at(&half, k)[0])
+            })
+            .collect();
+        let sampled = decoder::model::verify::largest_drop(&points, 1.0, Method::Sampled(n));
+        let exact = beyond.worst().unwrap().worst;
+        assert!(
+            sampled.amount <= exact.amount + exact.bound + 1e-9,
+            "sampled {sampled:?} exact {exact:?}"
+        );
+        assert!(
+            exact.amount - sampled.amount < 1e-4,
+            "{sampled:?} {exact:?}"
+        );
+        beyond
+    };
+    // No envelope (an older file): the raw polynomial on [0, 10] dips at 1.05.
+    let b = check(&model);
+    // Counted per finger and ray, as `verify_windows` counts: 5 fingers, one ray.
+    assert_eq!(
+        (b.rays(), b.reversing(), b.reversing_beyond_only()),
+        (5, 5, 5),
+        "{b}"
+    );
+    let w = b.worst().unwrap().worst;
+    assert!((w.amount - 0.02).abs() < 1e-6, "{w:?}");
+    assert!(w.from_k > 1.0 && w.to_k < 1.1, "{w:?}");
+    assert!(b.to_string().contains("NO envelope"));
+    // An envelope at the full window: the edge is at effort 2, past the dip: still found.
+    let wide = model
+        .clone()
+        .with_envelope(Some(Envelope::try_new(full.clone()).unwrap()))
+        .unwrap();
+    let b = check(&wide);
+    assert_eq!(b.reversing(), 5, "{b}");
+    assert!((b.entries[0].lowest_edge - 2.0).abs() < 1e-12, "{b}");
+    // An envelope at the half window: the edge is effort 1, the input held there: no dip.
+    let tight = model
+        .with_envelope(Some(Envelope::try_new(half.clone()).unwrap()))
+        .unwrap();
+    let b = check(&tight);
+    assert!(b.passed(), "{b}");
+    assert!((b.entries[0].lowest_edge - 1.0).abs() < 1e-12, "{b}");
+    assert!(b.to_string().contains("holds its direction"));
 }

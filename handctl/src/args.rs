@@ -378,6 +378,10 @@ pub struct EvalArgs {
     /// handctl built with the `plots` feature.
     #[arg(long)]
     pub plots: Option<PathBuf>,
+    /// Also replay the test windows at gains x1.5, x2, x3 and x5 and with one channel at ten
+    /// times its level (an electrode transient), per model: wrong-way windows and largest |y|.
+    #[arg(long)]
+    pub stress: bool,
     #[command(flatten)]
     pub training: TrainingOpts,
 }

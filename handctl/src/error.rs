@@ -81,6 +81,19 @@ pub enum CliError {
     /// Effort rays on which a finger goes back against the effort.
     #[error("{0} effort ray(s) reverse beyond the tolerance (listed above)")]
     Reversals(usize),
+    /// Effort rays on which a finger goes back, or beyond full scale, only beyond full effort.
+    #[error(
+        "beyond full effort (efforts up to {k_max}): {reversing} effort ray(s) reverse and \
+         {overshooting} overshoot beyond the tolerance (listed above); efforts [0, 1] pass"
+    )]
+    ReversalsBeyond {
+        /// Rays reversing.
+        reversing: usize,
+        /// Rays overshooting full scale.
+        overshooting: usize,
+        /// The largest effort checked.
+        k_max: f64,
+    },
     /// `handctl train` refused to write a model that reverses beyond the tolerance.
     #[error(
         "model NOT written: {verdict}. Retrain (another --seed, more --epochs), recalibrate, \

@@ -7,8 +7,9 @@
 use std::path::Path;
 
 use decoder::eval::{
-    direction_table, evaluate_model, interpolation_csv, interpolation_table, roc_csv, write_csv,
-    InterpolationConfig, ModelEvaluation,
+    direction_table, evaluate_model, interpolation_csv, interpolation_table, roc_csv, stress,
+    stress_table, stress_transients, write_csv, InterpolationConfig, ModelEvaluation, StressReport,
+    StressRow, TRANSIENT_GAIN, TRANSIENT_MS,
 };
 use decoder::model::verify::{describe_verification, DEFAULT_TOLERANCE};
 use decoder::model::TrainedModel;
@@ -123,10 +124,21 @@ fn run_saved(a: &EvalArgs, path: &Path) -> Result<(), CliError> {
     );
     let icfg = InterpolationConfig::default();
     let e = score(a, &model, &test, &icfg)?;
+    let reports = vec![(
+        model.summary().kind.name().to_string(),
+        stress(&model, &test),
+    )];
+    let transients = if a.stress {
+        vec![stress_transients(&model, &session)?]
+    } else {
+        Vec::new()
+    };
     print_tables(a, &[e], &icfg);
-    let r = super::verify::report(&model, &session, &test, DEFAULT_TOLERANCE)?;
+    print_robustness(a, &reports, &transients);
+    let (r, beyond) = super::verify::report(&model, &session, &test, DEFAULT_TOLERANCE)?;
     println!("\nEffort rays of {}:", a.session);
     print!("{r}");
+    print!("{beyond}");
     Ok(())
 }
 
@@ -152,14 +164,65 @@ pub fn run(a: &EvalArgs) -> Result<(), CliError> {
         }
     );
     let icfg = InterpolationConfig::default();
+    // The transients go into a test recording's signal: a separate test session only.
+    let test_session = match (&a.test, a.stress) {
+        (Some(spec), true) => Some(Session::open_spec(spec)?),
+        _ => None,
+    };
     let mut evals: Vec<ModelEvaluation> = Vec::new();
+    let mut reports = Vec::new();
+    let mut transients = Vec::new();
     for &kind in &a.models {
         let model = fit(kind, &data, &a.training)?;
         println!("trained {}", describe(&model));
         evals.push(score(a, &model, &test_w, &icfg)?);
+        reports.push((kind.name().to_string(), stress(&model, &test_w)));
+        if let Some(ts) = &test_session {
+            transients.push(stress_transients(&model, ts)?);
+        }
     }
     print_tables(a, &evals, &icfg);
+    print_robustness(a, &reports, &transients);
+    if a.stress && test_session.is_none() {
+        println!("(transients in the signal need a test session: --test)");
+    }
     Ok(())
+}
+
+/// Beyond the calibration (issue 25): per model, the test windows the envelope moved back or
+/// found implausible and the raw output's range; with `--stress`, the stress table.
+fn print_robustness(a: &EvalArgs, reports: &[(String, StressReport)], transients: &[StressRow]) {
+    println!("\nBeyond the calibration, on the test windows as recorded:");
+    for (name, r) in reports {
+        let x1 = &r.gains[0];
+        println!(
+            "  {name}: {} of {} windows beyond the calibration's envelope (moved back), {} \
+             implausible (rest); raw output in [{:.3}, {:.3}]",
+            x1.beyond, x1.windows, x1.implausible, x1.range.0, x1.range.1
+        );
+    }
+    if a.stress {
+        println!();
+        print!("{}", stress_table(reports));
+    }
+    if !transients.is_empty() {
+        println!(
+            "\nTransients in the signal: one channel at x{TRANSIENT_GAIN} for {TRANSIENT_MS} ms in \
+             the middle of every movement trial, the windows overlapping one (worst channel):"
+        );
+    }
+    for ((name, _), r) in reports.iter().zip(transients) {
+        println!(
+            "  {name}: {:.2}% of {} movement finger-windows the wrong way, |y| up to {:.3}, {} \
+             of {} windows implausible (rest); {}",
+            r.wrong_percent(),
+            r.movement,
+            r.max_abs,
+            r.implausible,
+            r.windows,
+            r.condition
+        );
+    }
 }
 
 /// What `--plots` writes in this build.

@@ -84,10 +84,35 @@ fn import_train_and_eval_on_the_3dc_proxy() {
         "5",
         "--plots",
         s(&plots),
+        "--stress",
     ]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     let o = text(&out.stdout);
     assert!(o.contains("Table 3") && o.contains("Table 4"), "{o}");
+    // Issue 25: the envelope's count and the output range per model, and the stress table.
+    for name in ["resdd", "ln"] {
+        assert!(
+            o.lines().any(|l| l.starts_with(&format!("  {name}: "))
+                && l.contains("windows beyond the calibration's envelope")
+                && l.contains("raw output in [")),
+            "{o}"
+        );
+    }
+    assert!(o.contains("Transients in the signal"), "{o}");
+    for name in ["resdd", "ln"] {
+        assert!(
+            o.lines().any(|l| l.starts_with(&format!("  {name}: "))
+                && l.contains("movement finger-windows the wrong way")
+                && l.contains("for 200 ms")),
+            "{o}"
+        );
+    }
+    for condition in ["x1.5 ", "x2 ", "x3 ", "x5 ", "worst channel at x10"] {
+        assert!(
+            o.lines().any(|l| l.starts_with(condition)),
+            "{condition}: {o}"
+        );
+    }
     assert!(
         o.lines().any(|l| l.starts_with("resdd ")) && o.lines().any(|l| l.starts_with("ln ")),
         "{o}"
@@ -198,6 +223,12 @@ fn train_and_verify_agree_on_the_effort_rays() {
     );
     assert_eq!(out.status.code(), Some(1), "{o}");
     assert!(text(&out.stderr).contains("reverse beyond the tolerance"));
+    // Then the same rays out to effort 10 (issue 25).
+    assert!(
+        o.lines()
+            .any(|l| l.starts_with(&format!("{} rays checked to effort 10", refused.1))),
+        "{o}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -15,6 +15,7 @@ mod interpolation;
 #[cfg(feature = "plots")]
 mod plot;
 mod stats;
+mod stress;
 mod table;
 mod tracking;
 
@@ -33,5 +34,9 @@ pub use interpolation::{
 #[cfg(feature = "plots")]
 pub use plot::{interpolation_png, roc_png};
 pub use stats::{average_ranks, linear_fit, pearson, spearman, LinearFit};
+pub use stress::{
+    stress, stress_table, stress_transients, StressReport, StressRow, STRESS_GAINS, TRANSIENT_GAIN,
+    TRANSIENT_MS, WRONG_WAY,
+};
 pub use table::{direction_table, interpolation_table};
 pub use tracking::{tracking_metrics, TrackingMetrics, MAPE_MIN_TARGET};

@@ -15,6 +15,13 @@
 //! reversals out. The jitter is redrawn every epoch, so over the epochs the whole ray is
 //! covered, not a fixed grid that a reversal could hide between; the exact verifier
 //! ([`super::verify`]) judges the result afterwards.
+//!
+//! Beyond full effort (issue 25 item 3, [`EffortPenalty::beyond`]): the predictor holds a
+//! window inside the calibration's envelope, so a ray's output past its edge `k_e` is its
+//! output at `k_e`; on `(1, k_e]` the model still runs, and may turn back. With `beyond > 0`,
+//! that many jittered points in equal strata of `(1, k_e]` and `k_e` itself are added to each
+//! ray, charged with slope margin 0 (there the output need only not go back: rising with slope
+//! `m` would push it past full scale).
 
 use serde::{Deserialize, Serialize};
 
@@ -35,6 +42,13 @@ pub struct EffortPenalty {
     /// Slope in the trial's direction below which an interval is charged, label units per unit
     /// of effort; the ideal `y = s·k` has slope 1 (default 0.3).
     pub min_slope: f64,
+    /// Jittered efforts per ray between full effort and the ray's envelope edge, besides the
+    /// edge itself (default 0: the penalty stops at full effort, as before issue 25, and as a
+    /// model file written before it says). 3 removes most reversals beyond full effort on the
+    /// 3DC participants but worsens P7's one-channel transient (decoder/tests/
+    /// beyond_penalty_3dc.rs, docs/EVALUATION.md): not the default yet.
+    #[serde(default)]
+    pub beyond: usize,
 }
 
 impl Default for EffortPenalty {
@@ -43,6 +57,7 @@ impl Default for EffortPenalty {
             weight: 30.0,
             points: 6,
             min_slope: 0.3,
+            beyond: 0,
         }
     }
 }
@@ -66,6 +81,12 @@ impl EffortPenalty {
                 self.points
             ));
         }
+        if self.beyond > MAX_EFFORT_POINTS {
+            return bad(format!(
+                "effort penalty beyond must be in 0..={MAX_EFFORT_POINTS}, got {}",
+                self.beyond
+            ));
+        }
         if !(0.0..=1.0).contains(&self.min_slope) {
             return bad(format!(
                 "effort penalty min_slope must be in [0, 1], got {}",
@@ -86,6 +107,40 @@ impl EffortPenalty {
             *k = (j as f64 + u) / n;
         }
         ks[self.points + 1] = 1.0;
+    }
+
+    /// Efforts per ray: both ends, the jittered points, and with [`EffortPenalty::beyond`] the
+    /// points past full effort and the edge.
+    pub fn n_efforts(&self) -> usize {
+        self.points + 2 + if self.beyond > 0 { self.beyond + 1 } else { 0 }
+    }
+
+    /// Jitters per ray ([`EffortPenalty::points`] + [`EffortPenalty::beyond`]).
+    pub fn n_jitter(&self) -> usize {
+        self.points + self.beyond
+    }
+
+    /// [`EffortPenalty::efforts`], then with `beyond > 0` one point per stratum of `(1, edge]`
+    /// and `edge` (`edge` <= 1: all at 1, charging nothing). `jitter` is
+    /// [`EffortPenalty::n_jitter`] long, `ks` [`EffortPenalty::n_efforts`].
+    pub fn efforts_to(&self, jitter: &[f64], edge: f64, ks: &mut [f64]) {
+        assert_eq!(jitter.len(), self.n_jitter(), "one jitter per stratum");
+        assert_eq!(ks.len(), self.n_efforts(), "efforts: n_efforts");
+        let p = self.points;
+        self.efforts(&jitter[..p], &mut ks[..p + 2]);
+        if self.beyond == 0 {
+            return;
+        }
+        let span = (edge - 1.0).max(0.0);
+        let n = self.beyond as f64;
+        for (j, (k, u)) in ks[p + 2..p + 2 + self.beyond]
+            .iter_mut()
+            .zip(&jitter[p..])
+            .enumerate()
+        {
+            *k = 1.0 + span * (j as f64 + u) / n;
+        }
+        ks[p + 2 + self.beyond] = 1.0 + span;
     }
 }
 
@@ -155,6 +210,8 @@ pub(crate) fn charge(
         if dk <= 0.0 {
             continue;
         }
+        // Past full effort the output need only not go back (see the module docs).
+        let min_slope = if ks[j] >= 1.0 { 0.0 } else { min_slope };
         for (f, &s) in dirs.iter().enumerate().filter(|(_, &s)| s != 0.0) {
             let r = min_slope - s * (y[j + 1][f] - y[j][f]) / dk;
             if r > 0.0 {
@@ -203,4 +260,46 @@ pub fn ray_directions(target: &[f64; N_FINGERS], mask: &[bool; N_FINGERS]) -> [f
             0.0
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn beyond_full_effort_the_points_reach_the_edge_and_charge_only_going_back() {
+        let e = EffortPenalty {
+            points: 2,
+            beyond: 2,
+            ..EffortPenalty::default()
+        };
+        assert_eq!((e.n_efforts(), e.n_jitter()), (7, 4));
+        let mut ks = vec![0.0; 7];
+        e.efforts_to(&[0.5, 0.5, 0.5, 0.5], 3.0, &mut ks);
+        assert_eq!(ks, [0.0, 0.25, 0.75, 1.0, 1.5, 2.5, 3.0]);
+        e.efforts_to(&[0.5, 0.5, 0.5, 0.5], 0.8, &mut ks);
+        assert_eq!(&ks[3..], &[1.0; 4], "an edge at or below 1 adds nothing");
+        let off = EffortPenalty::default();
+        assert_eq!((off.n_efforts(), off.n_jitter()), (8, 6));
+        // y = k up to 1, then flat: charged nowhere past 1 (margin 0 there), though the
+        // slope margin 0.3 would charge the flat part below 1.
+        let ks = [0.0, 0.5, 1.0, 2.0, 3.0];
+        let y: Vec<[f64; N_FINGERS]> = [0.0, 0.5, 1.0, 1.0, 1.0]
+            .iter()
+            .map(|v| [*v; N_FINGERS])
+            .collect();
+        let mut dy = vec![[0.0; N_FINGERS]; 5];
+        let dirs = [1.0, 0.0, 0.0, 0.0, 0.0];
+        assert_eq!(charge(&y, &mut dy, &dirs, &ks, 0.3), 0.0);
+        // Going back past 1 is charged.
+        let mut back = y.clone();
+        back[4][0] = 0.8;
+        assert!(charge(&back, &mut dy, &dirs, &ks, 0.3) > 0.0);
+        assert!(EffortPenalty {
+            beyond: MAX_EFFORT_POINTS + 1,
+            ..EffortPenalty::default()
+        }
+        .validate()
+        .is_err());
+    }
 }

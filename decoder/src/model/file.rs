@@ -22,8 +22,10 @@
 //! IEEE-754 doubles so they load bit for bit.
 //!
 //! Versions. Version 2 lists in `required` every metadata section present that changes what
-//! the model outputs (today `rest_stage`, the dead zone at rest, and `envelope`, the
-//! calibration's envelope its inputs are held inside: [`super::Envelope`]); a reader refuses a
+//! the model outputs (today `rest_stage`, the dead zone at rest, `envelope`, the
+//! calibration's envelope its inputs are held inside: [`super::Envelope`], and `taught`, per
+//! finger the directions the calibration taught, an untaught one held at 0: [`super::Taught`],
+//! written only when some direction was not taught); a reader refuses a
 //! file whose `required` names a section it does not know ([`FileError::UnknownRequired`]), so
 //! a newer file is never run with part of its behaviour silently dropped. Sections that only
 //! describe the model (`verification`, `rest_rms_uv`, `provenance`, the summary) are not
@@ -55,6 +57,7 @@ use super::provenance::Provenance;
 use super::rest::RestStage;
 use super::spec::ModelSpec;
 use super::summary::TrainingSummary;
+use super::taught::Taught;
 use super::trained::TrainedModel;
 use super::traits::{Model, TensorInfo, Trainable};
 use super::verify::VerificationRecord;
@@ -67,7 +70,7 @@ pub const FORMAT_VERSION: u32 = 2;
 /// The oldest format version this build reads.
 pub const OLDEST_VERSION: u32 = 1;
 /// The metadata sections this build knows how to apply, of those a file may mark `required`.
-pub const KNOWN_REQUIRED: &[&str] = &["rest_stage", "envelope"];
+pub const KNOWN_REQUIRED: &[&str] = &["rest_stage", "envelope", "taught"];
 /// Header length in bytes.
 pub const HEADER_LEN: usize = 24;
 /// Name of the normalizer tensor in the metadata and in errors.
@@ -106,6 +109,10 @@ struct Meta {
     /// Per input feature, the calibration's largest value (absent in older files).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     envelope: Option<Vec<f64>>,
+    /// The directions the calibration taught, per finger (absent in older files, and when both
+    /// directions of every finger were taught: the stage is then the identity).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    taught: Option<Taught>,
     /// Absent in older files: which patient and session (descriptive, never required).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     provenance: Option<Provenance>,
@@ -220,6 +227,11 @@ fn read_meta(version: u32, body: &[u8]) -> Result<(Meta, &[u8]), FileError> {
         .collect();
     if !unknown.is_empty() {
         return Err(FileError::UnknownRequired { sections: unknown });
+    }
+    if meta.taught.is_some() && !meta.required.iter().any(|r| r == "taught") {
+        return Err(malformed(
+            "taught present but not listed in required".into(),
+        ));
     }
     if meta.rest_stage.is_some() && !meta.required.iter().any(|r| r == "rest_stage") {
         // Only a version 1 file may carry a rest stage without saying it is required.
@@ -418,10 +430,12 @@ impl TrainedModel {
             rest_rms_uv: self.rest_rms_uv.clone(),
             rest_stage: self.rest_stage,
             envelope: self.envelope.as_ref().map(|e| e.max().to_vec()),
+            taught: (!self.taught.is_both()).then_some(self.taught),
             provenance: self.provenance.clone(),
             required: [
                 self.rest_stage.is_some().then_some("rest_stage"),
                 self.envelope.is_some().then_some("envelope"),
+                (!self.taught.is_both()).then_some("taught"),
             ]
             .into_iter()
             .flatten()
@@ -475,7 +489,8 @@ impl TrainedModel {
             meta.rest_rms_uv,
             meta.rest_stage,
             meta.provenance,
-        )?;
+        )?
+        .with_taught(meta.taught.unwrap_or_default());
         match meta.envelope {
             Some(max) => {
                 let envelope = super::Envelope::try_new(max)

@@ -9,6 +9,8 @@
 //!   every trial), deterministic for a given seed.
 //! - [`RestStage`]: a soft dead zone per finger fitted from the calibration's rest windows, so a
 //!   relaxed hand stays still (monotonic, keeps ±1 at ±1).
+//! - [`Taught`]: the directions the calibration taught per finger; an untaught one is held at 0
+//!   ([`OutputStage`]: the rest stage then that hold, shared by predictor and verifier).
 //! - [`Provenance`]: which patient, which session, when, and any quality gates bypassed.
 //! - [`TrainedModel`]: what a model file holds ([`TrainedModel::save`] / [`TrainedModel::load`]);
 //!   [`Predictor`] runs it in the daemon's tick.
@@ -40,6 +42,7 @@ mod linalg;
 mod matvec_x86;
 mod normalizer;
 mod optim;
+mod output;
 pub mod provenance;
 mod resdd;
 mod resdd_batch;
@@ -47,6 +50,7 @@ mod rest;
 mod spec;
 mod split;
 mod summary;
+mod taught;
 mod train;
 mod trained;
 mod traits;
@@ -64,6 +68,7 @@ pub use error::{FileError, ModelError, TrainError};
 pub use file::{FORMAT_VERSION, HEADER_LEN, MAGIC, NORMALIZER_TENSOR};
 pub use kind::ModelKind;
 pub use normalizer::Normalizer;
+pub use output::OutputStage;
 pub use provenance::Provenance;
 pub use resdd::{ResDd, ResDdActivations, RESDD_INPUT_GAIN};
 pub use rest::{RestFit, RestStage, MAX_REST_WIDTH, REST_SHARPNESS};
@@ -71,6 +76,7 @@ pub use spec::{
     CnnSpec, LnSpec, MlpSpec, ModelSpec, ResDdSpec, ResDdVariant, MAX_MODULES, MAX_WIDTH,
 };
 pub use summary::TrainingSummary;
+pub use taught::Taught;
 pub use train::{train, EpochReport};
 pub use trained::{Predictor, TrainedModel};
 pub use traits::{Model, Scratch, TensorInfo, Trainable};

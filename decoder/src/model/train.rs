@@ -52,16 +52,34 @@ pub struct EpochReport {
 struct Normalized<'d> {
     data: &'d Dataset,
     xn: Vec<f64>,
+    /// Per window, its ray's envelope edge (see [`EffortPenalty::beyond`]); empty when the
+    /// penalty stops at full effort.
+    edge: Vec<f64>,
 }
 
 impl<'d> Normalized<'d> {
-    fn new(data: &'d Dataset, normalizer: &Normalizer) -> Self {
+    fn new(data: &'d Dataset, normalizer: &Normalizer, envelope: Option<&super::Envelope>) -> Self {
         let nf = data.n_features();
         let mut xn = vec![0.0; data.len() * nf];
         for (i, out) in xn.chunks_exact_mut(nf).enumerate() {
             normalizer.apply(data.row(i), out);
         }
-        Normalized { data, xn }
+        let edge = envelope.map_or_else(Vec::new, |e| {
+            let k_max = super::verify::BEYOND_EFFORT;
+            let mut scaled = vec![0.0; nf];
+            (0..data.len())
+                .map(|i| {
+                    crate::eval::scale_features(data.row(i), k_max, &mut scaled);
+                    k_max * e.scale_of(&scaled)
+                })
+                .collect()
+        });
+        Normalized { data, xn, edge }
+    }
+
+    /// Window `i`'s envelope edge along its ray (1 without one).
+    fn edge(&self, i: usize) -> f64 {
+        self.edge.get(i).copied().unwrap_or(1.0)
     }
 
     /// Normalized features of window `i`.
@@ -110,7 +128,7 @@ impl Workspace {
     fn new(model: &AnyModel, cfg: &TrainConfig) -> Self {
         let n_params = model.params().len();
         let batch = cfg.batch_size;
-        let ray_rows = cfg.effort.map_or(0, |e| batch * (e.points + 2));
+        let ray_rows = cfg.effort.map_or(0, |e| batch * e.n_efforts());
         Workspace {
             opt: OptimState::new(cfg.optimizer, n_params),
             grad: vec![0.0; n_params],
@@ -121,9 +139,9 @@ impl Workspace {
             dy: vec![[0.0; N_FINGERS]; batch],
             effort: cfg.effort.map(|e| EffortWork {
                 cfg: e,
-                jitter: vec![0.0; e.points],
-                ks: vec![0.0; e.points + 2],
-                rays: RayBatch::new(model.n_inputs(), e.points + 2, batch),
+                jitter: vec![0.0; e.n_jitter()],
+                ks: vec![0.0; e.n_efforts()],
+                rays: RayBatch::new(model.n_inputs(), e.n_efforts(), batch),
             }),
         }
     }
@@ -210,7 +228,6 @@ fn validation_loss(
         return mse;
     };
     e.jitter.fill(0.5);
-    e.cfg.efforts(&e.jitter, &mut e.ks);
     let (mut penalty, mut count) = (0.0, 0usize);
     for chunk in idx.chunks(ws.batch) {
         e.rays.clear();
@@ -219,6 +236,7 @@ fn validation_loss(
             count += m.iter().filter(|&&b| b).count();
             let dirs = ray_directions(t, m);
             if dirs.iter().any(|&d| d != 0.0) {
+                e.cfg.efforts_to(&e.jitter, set.edge(i), &mut e.ks);
                 e.rays.push(set.x(i), &dirs, &e.ks);
             }
         }
@@ -293,7 +311,7 @@ fn batch_gradient(
             for u in e.jitter.iter_mut() {
                 *u = rng.unit();
             }
-            e.cfg.efforts(&e.jitter, &mut e.ks);
+            e.cfg.efforts_to(&e.jitter, set.edge(i), &mut e.ks);
             e.rays.push(set.x(i), &dirs, &e.ks);
         }
         let grad = Some((&mut ws.grad[..], e.cfg.weight * inv));
@@ -413,7 +431,11 @@ pub fn train(
     }
     let nf = data.n_features();
     let normalizer = Normalizer::fit(nf, split.train.iter().map(|&i| data.row(i)))?;
-    let set = Normalized::new(data, &normalizer);
+    // Every window of the calibration (the validation part too: it is the patient's signal all
+    // the same) bounds what the model may see.
+    let envelope = super::Envelope::fit(nf, (0..data.len()).map(|i| data.row(i)))?;
+    let beyond = cfg.effort.is_some_and(|e| e.beyond > 0);
+    let set = Normalized::new(data, &normalizer, beyond.then_some(&envelope));
     let mut model = AnyModel::init(kind, spec, nf, N_FINGERS, &mut rng)?;
     let outcome = run_epochs(&mut model, &set, &split, cfg, &mut rng, progress)?;
     let summary = TrainingSummary {
@@ -430,10 +452,9 @@ pub fn train(
         n_val_trials: distinct_trials(data, &split.val),
         duration_ms: u64::try_from(started.elapsed().as_millis()).unwrap_or(u64::MAX),
     };
-    // Every window of the calibration (the validation part too: it is the patient's signal all
-    // the same) bounds what the model may see.
-    let envelope = super::Envelope::fit(nf, (0..data.len()).map(|i| data.row(i)))?;
     let trained = TrainedModel::new(model, *spec, normalizer, data.chain().clone(), summary)?
         .with_envelope(Some(envelope))?;
-    Ok(super::rest::with_fitted_rest(trained, data, cfg.rest)?)
+    let trained = super::rest::with_fitted_rest(trained, data, cfg.rest)?;
+    // A direction no label taught is held at 0 (issue 25 item 4).
+    Ok(trained.with_taught(super::Taught::of_dataset(data)))
 }

@@ -8,10 +8,12 @@ use super::dataset::N_FINGERS;
 use super::envelope::Envelope;
 use super::error::ModelError;
 use super::normalizer::Normalizer;
+use super::output::OutputStage;
 use super::provenance::Provenance;
 use super::rest::RestStage;
 use super::spec::ModelSpec;
 use super::summary::TrainingSummary;
+use super::taught::Taught;
 use super::traits::{Model, Scratch, Trainable};
 use super::verify::VerificationRecord;
 
@@ -30,6 +32,7 @@ pub struct TrainedModel {
     pub(crate) rest_stage: Option<RestStage>,
     pub(crate) envelope: Option<Envelope>,
     pub(crate) provenance: Option<Provenance>,
+    pub(crate) taught: Taught,
 }
 
 impl TrainedModel {
@@ -87,6 +90,7 @@ impl TrainedModel {
             rest_stage: None,
             envelope: None,
             provenance: None,
+            taught: Taught::BOTH,
         })
     }
 
@@ -173,6 +177,27 @@ impl TrainedModel {
         self.rest_stage.as_ref()
     }
 
+    /// The model with `taught` as the directions its calibration taught: an untaught one is
+    /// held at 0 in its outputs (see [`Taught`]).
+    pub fn with_taught(mut self, taught: Taught) -> Self {
+        self.taught = taught;
+        self
+    }
+
+    /// The directions the calibration taught ([`Taught::BOTH`] for an older file).
+    pub fn taught(&self) -> &Taught {
+        &self.taught
+    }
+
+    /// What the model does to the network's raw outputs: the rest stage, then the untaught
+    /// directions held at 0. The predictor and the verifier both run it.
+    pub fn output_stage(&self) -> OutputStage {
+        OutputStage {
+            rest: self.rest_stage,
+            taught: self.taught,
+        }
+    }
+
     /// The model.
     pub fn model(&self) -> &AnyModel {
         &self.model
@@ -237,7 +262,7 @@ impl TrainedModel {
         Predictor {
             model: self.model.clone(),
             normalizer: self.normalizer.clone(),
-            rest_stage: self.rest_stage,
+            stage: self.output_stage(),
             envelope: self.envelope.clone(),
             scratch: self.model.new_scratch(),
             xp: vec![0.0; self.normalizer.len()],
@@ -249,12 +274,13 @@ impl TrainedModel {
 }
 
 /// Runs a trained model on raw feature vectors without allocating: the envelope when the model
-/// has one, normalize, predict, then the rest stage when the model has one.
+/// has one, normalize, predict, then the output stage ([`OutputStage`]: the rest stage when the
+/// model has one, the untaught directions held at 0).
 #[derive(Debug, Clone)]
 pub struct Predictor {
     model: AnyModel,
     normalizer: Normalizer,
-    rest_stage: Option<RestStage>,
+    stage: OutputStage,
     envelope: Option<Envelope>,
     scratch: Scratch,
     /// The features held inside the envelope.
@@ -290,9 +316,7 @@ impl Predictor {
         }
         let mut y = [0.0; N_FINGERS];
         self.model.predict_with(&self.xn, &mut y, &mut self.scratch);
-        if let Some(stage) = &self.rest_stage {
-            stage.apply(&mut y);
-        }
+        self.stage.apply(&mut y);
         y
     }
 

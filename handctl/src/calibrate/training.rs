@@ -65,8 +65,11 @@ pub fn train_session(
     let model = fit(ModelKind::ResDd, &data, opts)?;
     let description = describe(&model);
     let windows = session.windows(&WindowOptions::default())?;
-    let report = crate::verify::report(&model, &session, &windows, tolerance)?;
+    let (report, beyond) = crate::verify::report(&model, &session, &windows, tolerance)?;
     let record = VerificationRecord::from_report(&report, false);
+    if !beyond.passed() {
+        eprint!("WARNING: {beyond}");
+    }
     if !report.passed() {
         eprint!("{report}");
         return Err(CliError::Refused {

@@ -34,6 +34,9 @@ pub enum VerifyError {
         /// Trials in the session.
         trials: usize,
     },
+    /// A largest effort below 1 or not finite.
+    #[error("largest effort {0} must be finite and >= 1")]
+    Effort(f64),
     /// A tolerance that is negative or not finite.
     #[error("tolerance {0} must be finite and >= 0")]
     Tolerance(f64),

@@ -7,11 +7,14 @@
 //! trial's direction, `max dir·(y(k1) - y(k2))` over `k1 < k2`, is read at its critical points,
 //! the real roots of `y'` in `[0, 1]`, found by Bernstein subdivision (see `roots.rs`: a
 //! root-free interval is proven root-free, never assumed). The models have no output clamp or
-//! squashing; a model with a rest stage ([`crate::model::RestStage`], strictly increasing) is
+//! squashing; a model with an output stage ([`crate::model::OutputStage`]: rest stage and untaught
+//! directions held at 0, non-decreasing) is
 //! read through it at the same critical points. MLP and CNN (ReLU) are checked by sampling
 //! [`SAMPLED_POINTS`] efforts and say so. A model file keeps the outcome as a
-//! [`VerificationRecord`].
+//! [`VerificationRecord`]. Beyond full effort, [`verify_beyond`] checks the rays out to
+//! [`BEYOND_EFFORT`] through the calibration envelope's clipping (`beyond.rs`).
 
+mod beyond;
 mod error;
 mod poly;
 mod propagate;
@@ -21,6 +24,7 @@ mod report;
 mod reversal;
 mod roots;
 
+pub use beyond::{verify_beyond, BeyondEntry, BeyondReport, BEYOND_EFFORT};
 pub use error::VerifyError;
 pub use poly::eval as eval_polynomial;
 pub use propagate::{output_degree, var_index, MAX_DEGREE};

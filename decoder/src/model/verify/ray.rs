@@ -5,7 +5,7 @@ use super::poly::eval;
 use super::propagate::{check_polynomial, ray_polynomials};
 use super::reversal::{exact_reversal_through, largest_drop, Method, Reversal};
 use crate::eval::scale_features;
-use crate::model::{Model, ModelKind, Predictor, RestStage, TrainedModel, N_FINGERS};
+use crate::model::{Envelope, Model, ModelKind, OutputStage, Predictor, TrainedModel, N_FINGERS};
 
 /// Efforts sampled for a model that is not polynomial (MLP, CNN).
 pub const SAMPLED_POINTS: usize = 1001;
@@ -13,9 +13,9 @@ pub const SAMPLED_POINTS: usize = 1001;
 /// A model's outputs along one ray.
 #[derive(Debug, Clone, PartialEq)]
 pub enum RayCurves {
-    /// One polynomial in `k` per finger (power basis): the model's raw output, and the rest
+    /// One polynomial in `k` per finger (power basis): the model's raw output, and the output
     /// stage the model applies to it (the curve is the stage of the polynomial).
-    Polynomials(Vec<Vec<f64>>, Option<RestStage>),
+    Polynomials(Vec<Vec<f64>>, OutputStage),
     /// Outputs at `k = i / (n - 1)`, `i = 0..n`.
     Sampled(Vec<[f64; N_FINGERS]>),
 }
@@ -77,7 +77,7 @@ impl<'m> RayVerifier<'m> {
         match self.method {
             Method::Exact => RayCurves::Polynomials(
                 ray_polynomials(self.model, features),
-                self.model.rest_stage().copied(),
+                self.model.output_stage(),
             ),
             Method::Sampled(n) => RayCurves::Sampled(
                 (0..n)
@@ -85,6 +85,29 @@ impl<'m> RayVerifier<'m> {
                     .collect(),
             ),
         }
+    }
+
+    /// The envelope the model holds its inputs inside (None: an older file).
+    pub fn envelope(&self) -> Option<&'m Envelope> {
+        self.model.envelope()
+    }
+
+    /// For an exact method, each finger's raw output polynomial along the ray through
+    /// `features` and the output stage applied to it (None when sampled).
+    pub(super) fn polynomials(&self, features: &[f64]) -> Option<(Vec<Vec<f64>>, OutputStage)> {
+        (self.method == Method::Exact).then(|| {
+            (
+                ray_polynomials(self.model, features),
+                self.model.output_stage(),
+            )
+        })
+    }
+
+    /// Whether the predictor finds the window at effort `k` on the ray through `features`
+    /// implausible (it then outputs rest).
+    pub fn implausible_at(&mut self, features: &[f64], k: f64) -> bool {
+        self.output_at(features, k);
+        self.predictor.last_implausible()
     }
 
     /// The model's real forward pass at effort `k` on the ray through `features`.
@@ -98,8 +121,7 @@ impl RayCurves {
     /// The worst reversal of `finger`'s output against `dir` (+1 flexion, -1 extension).
     pub fn reversal(&self, finger: usize, dir: f64) -> Reversal {
         match self {
-            RayCurves::Polynomials(p, None) => exact_reversal_through(&p[finger], dir, &|v| v, 1.0),
-            RayCurves::Polynomials(p, Some(st)) => exact_reversal_through(
+            RayCurves::Polynomials(p, st) => exact_reversal_through(
                 &p[finger],
                 dir,
                 &|v| st.map(finger, v),
@@ -121,8 +143,7 @@ impl RayCurves {
     /// sample).
     pub fn value(&self, finger: usize, k: f64) -> f64 {
         match self {
-            RayCurves::Polynomials(p, None) => eval(&p[finger], k),
-            RayCurves::Polynomials(p, Some(st)) => st.map(finger, eval(&p[finger], k)),
+            RayCurves::Polynomials(p, st) => st.map(finger, eval(&p[finger], k)),
             RayCurves::Sampled(ys) => {
                 let i = (k.clamp(0.0, 1.0) * (ys.len() - 1) as f64).round() as usize;
                 ys[i][finger]

@@ -138,7 +138,7 @@ pub fn verify_windows(
     })
 }
 
-fn check_inputs(
+pub(super) fn check_inputs(
     verifier: &RayVerifier<'_>,
     windows: &LabelledWindows,
     trials: &[Trial],
