@@ -1,8 +1,9 @@
 //! Issue 16: no stale setpoint can move a finger. After a bus-off and handd's recovery, an
 //! ACTIVE setpoint of the epoch before the bus-off, injected with a raw socket with a correct
 //! CRC and an alive counter in sequence (the worst case of a frame left in a queue), does not
-//! move the simulated finger; the same frame in the current epoch does (the control that shows
-//! the injection reaches the controller and would move it).
+//! move the simulated finger; the same frame in the epoch the controller follows once handd's
+//! stream is trusted again does (the control that shows the injection reaches the controller
+//! and would move it).
 
 use std::time::{Duration, Instant};
 
@@ -17,9 +18,14 @@ use super::{wait_scenario_start, Rig, DRILL_SILENCE_MS, ONSET_US, RUN_S};
 const FINGER: usize = 1;
 /// FINGER_STATUS fault bit 6: a setpoint ignored by the epoch rule.
 const FAULT_STALE_EPOCH: u8 = 1 << 6;
-/// Injections of the stale frame (one after every other setpoint of handd's, so the
-/// controller still gets a valid setpoint every 100 ms and never brakes by itself).
+/// Injections of the stale frame, one after every other setpoint of handd's. Each is a second
+/// sender in handd's stream: the first reaches the epoch rule; Profile 1's sync counter holds
+/// back the frames after it, so the controller may brake by itself and retire handd's epoch
+/// too (handd then binds a new one with its safe stops).
 const STALE_INJECTIONS: usize = 5;
+/// After the stale frames, time for the controller to brake by itself (150 ms), handd to bind
+/// it to a new epoch and its stream to be trusted again, ms.
+const SETTLE_MS: u64 = 800;
 /// How far the finger may drift while the stale frames come, rad (2 status LSB).
 const STILL_RAD: f64 = 0.002;
 /// How far the control injection must move it at least, rad.
@@ -141,7 +147,10 @@ fn bus_off_then_inject(rig: &Rig, reader: &CanSocket, w: &CanSocket) -> Injected
         next_handd_setpoint(reader);
         inject_after(reader, w, old, velocity);
     }
-    next_handd_setpoint(reader);
+    std::thread::sleep(Duration::from_millis(SETTLE_MS));
+    reader.set_nonblocking(true).expect("nonblocking");
+    while reader.read_frame().is_ok() {}
+    reader.set_nonblocking(false).expect("blocking");
     let current = next_handd_setpoint(reader).epoch();
     let control_at = inject_after(reader, w, current, velocity);
     Injected {
