@@ -280,6 +280,9 @@ fn b_closed_loop_tracks_a_sine_over_vcan() {
         .collect();
     let ids: std::collections::BTreeSet<u32> = cd.iter().map(|e| e.frame.raw_id()).collect();
     let (mut compared, mut same_frames, mut worst_dt) = (0usize, true, 0u64);
+    // Evidence for a disagreement (issue 29: an intermittent failure is explained, not
+    // retried): the first one of each id, with both stamps and payloads.
+    let mut why: Vec<String> = Vec::new();
     for id in ids {
         let theirs_id: Vec<_> = cd.iter().filter(|e| e.frame.raw_id() == id).collect();
         let ours_id: Vec<_> = log.iter().filter(|e| e.frame.raw_id() == id).collect();
@@ -288,9 +291,44 @@ fn b_closed_loop_tracks_a_sine_over_vcan() {
             e.frame.data() == first.frame.data() && e.time_us.abs_diff(first.time_us) <= 1_000
         }) else {
             same_frames = false;
+            let near = ours_id
+                .iter()
+                .min_by_key(|e| e.time_us.abs_diff(first.time_us))
+                .map(|e| format!("{} {:02x?}", e.time_us, e.frame.data()));
+            why.push(format!(
+                "id {id:#x}: candump's first frame {} {:02x?} has no match within 1 ms in \
+                 ours (nearest in time: {near:?})",
+                first.time_us,
+                first.frame.data()
+            ));
             continue;
         };
         let ours_run = &ours_id[at..(at + theirs_id.len()).min(ours_id.len())];
+        if ours_run.len() != theirs_id.len() {
+            why.push(format!(
+                "id {id:#x}: {} frames in ours from the match, {} in candump's",
+                ours_run.len(),
+                theirs_id.len()
+            ));
+        }
+        if let Some((k, (a, b))) =
+            ours_run
+                .iter()
+                .zip(&theirs_id)
+                .enumerate()
+                .find(|(_, (a, b))| {
+                    a.frame.data() != b.frame.data() || a.time_us.abs_diff(b.time_us) > 1_000
+                })
+        {
+            why.push(format!(
+                "id {id:#x}, frame {k} of {}: ours {} {:02x?}, candump's {} {:02x?}",
+                theirs_id.len(),
+                a.time_us,
+                a.frame.data(),
+                b.time_us,
+                b.frame.data()
+            ));
+        }
         same_frames &= ours_run.len() == theirs_id.len()
             && ours_run
                 .iter()
@@ -304,6 +342,9 @@ fn b_closed_loop_tracks_a_sine_over_vcan() {
         compared += ours_run.len();
     }
     let ours = &log[..compared.min(log.len())];
+    for line in why.iter().take(12) {
+        println!("candump vs handctl record: {line}");
+    }
     println!(
         "candump -L and handctl record: {} and {} frames in their common {:.1} s; same frames \
          in the same order: {same_frames}; largest timestamp difference {worst_dt} us",
