@@ -8,7 +8,8 @@
 //! 4 at ten times its level points 39.4% of its movement finger-windows the wrong way (26.8%
 //! with today's default; eval_3dc's bar is 30%), and LN trained the same way beats it on P6.
 
-use std::path::PathBuf;
+mod data_3dc;
+use data_3dc::data_dir;
 
 use decoder::eval::{evaluate_model, InterpolationConfig};
 use decoder::model::verify::{
@@ -16,13 +17,6 @@ use decoder::model::verify::{
 };
 use decoder::model::{train, EffortPenalty, ModelKind, ModelSpec, TrainConfig};
 use decoder::session::{load_3dc, Split, WindowOptions};
-
-fn data_dir(participant: u32) -> PathBuf {
-    PathBuf::from(format!(
-        "{}/../../shared/data/3dc-armband-p{participant}",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-}
 
 #[test]
 // A measurement of an option that is off (about 50 s: six trainings): kept out of the test

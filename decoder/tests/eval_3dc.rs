@@ -3,7 +3,8 @@
 //! recordings, keeps a relaxed hand still, and, trained with the effort-ray penalty (the
 //! default), is proven monotonic on every training ray by the exact verifier (issue 12).
 
-use std::path::PathBuf;
+mod data_3dc;
+use data_3dc::data_dir;
 
 use decoder::eval::{direction_table, evaluate_model, interpolation_table, InterpolationConfig};
 use decoder::model::verify::{
@@ -11,19 +12,6 @@ use decoder::model::verify::{
 };
 use decoder::model::{train, ModelKind, ModelSpec, TrainConfig};
 use decoder::session::{load_3dc, Split, WindowOptions};
-
-fn data_dir(participant: u32) -> PathBuf {
-    let d = PathBuf::from(format!(
-        "{}/../../shared/data/3dc-armband-p{participant}",
-        env!("CARGO_MANIFEST_DIR")
-    ));
-    assert!(
-        d.join(format!("P{participant}_train_emg.npy")).exists(),
-        "{} is missing: the tests read the real recordings from ../shared/data",
-        d.display()
-    );
-    d
-}
 
 #[test]
 fn resdd_on_3dc_separates_grip_from_open_hand_on_p4_p6_and_p7() {

@@ -6,26 +6,14 @@
 //! taught gesture and the gesture it never saw), and still output the taught one. The same
 //! weights without the hold ([`Taught::BOTH`]) show what the network alone does.
 
-use std::path::PathBuf;
+mod data_3dc;
+use data_3dc::data_dir;
 
 use decoder::model::{train, ModelKind, ModelSpec, Taught, TrainConfig, TrainedModel, N_FINGERS};
 use decoder::session::{load_3dc, LabelledWindows, Split, TrialKind, WindowOptions};
 
 /// Largest output accepted in an untaught direction, label units (full effort is 1).
 const TOLERANCE: f64 = 0.05;
-
-fn data_dir(participant: u32) -> PathBuf {
-    let d = PathBuf::from(format!(
-        "{}/../../shared/data/3dc-armband-p{participant}",
-        env!("CARGO_MANIFEST_DIR")
-    ));
-    assert!(
-        d.join(format!("P{participant}_train_emg.npy")).exists(),
-        "{} is missing: the tests read the real recordings from ../shared/data",
-        d.display()
-    );
-    d
-}
 
 /// The largest output in the direction `sign` (+1 flexion, -1 extension) over every finger and
 /// window, and the share of the `taught` gesture's finger-windows beyond 0.2 its way.
