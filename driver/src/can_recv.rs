@@ -19,6 +19,8 @@ use std::os::fd::RawFd;
 use nix::sys::socket::{recvmsg, ControlMessageOwned, MsgFlags};
 use nix::sys::time::TimeSpec;
 
+use hand_dbc::CanFrame;
+
 /// `sizeof(struct can_frame)`: a classic CAN frame as the kernel hands it to a raw socket.
 pub const CAN_MTU: usize = 16;
 
@@ -63,6 +65,35 @@ pub enum RawFrame {
         /// Data bytes (controller state in byte 1, error counters in 6 and 7).
         data: [u8; 8],
     },
+}
+
+impl RawFrame {
+    /// The data or remote frame as the codec's frame; None for an error frame (and for an id
+    /// out of range, which the kernel never gives).
+    pub fn to_frame(&self) -> Option<CanFrame> {
+        fn id_of(id: u32, extended: bool) -> Option<socketcan::Id> {
+            if extended {
+                socketcan::ExtendedId::new(id).map(socketcan::Id::Extended)
+            } else {
+                u16::try_from(id)
+                    .ok()
+                    .and_then(socketcan::StandardId::new)
+                    .map(socketcan::Id::Standard)
+            }
+        }
+        match *self {
+            RawFrame::Data {
+                id,
+                extended,
+                len,
+                data,
+            } => id_of(id, extended).and_then(|i| CanFrame::new(i, &data[..len])),
+            RawFrame::Remote { id, extended, dlc } => {
+                id_of(id, extended).and_then(|i| CanFrame::new_remote(i, dlc))
+            }
+            RawFrame::Error { .. } => None,
+        }
+    }
 }
 
 /// Decodes the bytes of a `struct can_frame` (native byte order, as the kernel writes it).

@@ -32,6 +32,10 @@ use crate::transport::{BusHealth, ControllerState, Timestamped, Transport, Trans
 /// frame costs the socket one skb, about 960 bytes of truesize on 64-bit kernels: 700 frames
 /// in 200 ms, 672,000 bytes, rounded up to 656 KiB. 200 ms is four ticks: a tick that starts
 /// three ticks late still finds every frame. The kernel default (208 KiB) holds about 60 ms.
+/// Measured on Debian's 6.1 kernel with vcan (the VM suite): the kernel doubles the request
+/// for its bookkeeping and a frame costs about 700 bytes there, so the queue holds about
+/// 1,900 frames, 0.55 s of the bus (a 500 ms stall of handd lost none, a 700 ms stall of
+/// `handctl record`, same size, lost 539); the figure above is the conservative floor.
 pub const RCVBUF_BYTES: usize = 656 * 1024;
 
 /// Linux `CAN_ERR_*` bits of an error frame's id and data bytes (linux/can/error.h).
@@ -122,18 +126,6 @@ pub struct SocketCanTransport<K: Clock> {
     health: BusHealth,
 }
 
-/// The id of a received frame (None for an id out of range, which the kernel never gives).
-fn can_id(id: u32, extended: bool) -> Option<socketcan::Id> {
-    if extended {
-        socketcan::ExtendedId::new(id).map(socketcan::Id::Extended)
-    } else {
-        u16::try_from(id)
-            .ok()
-            .and_then(socketcan::StandardId::new)
-            .map(socketcan::Id::Standard)
-    }
-}
-
 fn wall_us() -> i128 {
     SystemTime::now()
         .duration_since(UNIX_EPOCH)
@@ -209,25 +201,29 @@ impl<K: Clock> SocketCanTransport<K> {
     }
 }
 
+/// Asks the kernel for a receive buffer of [`RCVBUF_BYTES`] on `sock`; returns what it granted
+/// (the kernel caps the request at `net.core.rmem_max`). Shared by handd and handctl's
+/// listen-only sockets (`handctl record`, the monitor, calibration).
+pub fn size_receive_buffer(sock: &CanSocket) -> std::io::Result<usize> {
+    use std::os::fd::AsFd;
+    let fd = sock.as_fd();
+    rustix::net::sockopt::set_socket_recv_buffer_size(fd, RCVBUF_BYTES)?;
+    // The kernel doubles the request for its bookkeeping and caps it at rmem_max.
+    Ok(rustix::net::sockopt::socket_recv_buffer_size(fd)? / 2)
+}
+
 impl<K: Clock> SocketCanTransport<K> {
     /// Asks for [`RCVBUF_BYTES`]; logs what the kernel granted when it is less.
     fn size_receive_buffer(&self, sock: &CanSocket) {
-        use std::os::fd::AsFd;
-        let fd = sock.as_fd();
-        if let Err(e) = rustix::net::sockopt::set_socket_recv_buffer_size(fd, RCVBUF_BYTES) {
-            tracing::warn!(error = %e, "could not size the CAN receive buffer");
-            return;
-        }
-        // The kernel doubles the request for its bookkeeping and caps it at rmem_max.
-        match rustix::net::sockopt::socket_recv_buffer_size(fd) {
-            Ok(got) if got / 2 < RCVBUF_BYTES => tracing::warn!(
+        match size_receive_buffer(sock) {
+            Ok(got) if got < RCVBUF_BYTES => tracing::warn!(
                 wanted = RCVBUF_BYTES,
-                got = got / 2,
+                got,
                 "CAN receive buffer smaller than wanted: set net.core.rmem_max to at least \
                  the wanted size (README, install) or a late tick may lose frames"
             ),
             Ok(_) => {}
-            Err(e) => tracing::warn!(error = %e, "could not read the CAN receive buffer size"),
+            Err(e) => tracing::warn!(error = %e, "could not size the CAN receive buffer"),
         }
     }
 }
@@ -255,23 +251,14 @@ impl<K: Clock> Transport for SocketCanTransport<K> {
             let ts_us = meta.stamp_us.unwrap_or(now_wall);
             let rx_us = self.rx_times.map(ts_us, now_wall, self.clock.now_us());
             self.health.counters.clock_steps = self.rx_times.steps();
-            let ours = match can_recv::decode(self.rx_buf.frame()) {
-                RawFrame::Data {
-                    id,
-                    extended,
-                    len,
-                    data,
-                } => can_id(id, extended).and_then(|i| CanFrame::new(i, &data[..len])),
-                RawFrame::Remote { id, extended, dlc } => {
-                    can_id(id, extended).and_then(|i| CanFrame::new_remote(i, dlc))
+            let raw = can_recv::decode(self.rx_buf.frame());
+            if let RawFrame::Error { bits, data } = raw {
+                if on_error_frame(bits, &data, &mut self.health) {
+                    return Err(TransportError::BusOff);
                 }
-                RawFrame::Error { bits, data } => {
-                    if on_error_frame(bits, &data, &mut self.health) {
-                        return Err(TransportError::BusOff);
-                    }
-                    continue;
-                }
-            };
+                continue;
+            }
+            let ours = raw.to_frame();
             if let Some(f) = ours {
                 return Ok(Some((f, rx_us)));
             }

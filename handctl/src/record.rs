@@ -23,11 +23,10 @@ use decoder::dsp::ChainConfig;
 use decoder::session::{SessionMeta, Trial, TrialTable};
 use hand_dbc::candump::LogWriter;
 use hand_dbc::emg::EMG_CHANNELS;
-use hand_dbc::CanFrame;
-use socketcan::{CanSocket, EmbeddedFrame};
 
 use super::args::RecordArgs;
 use super::error::CliError;
+use super::listen::Listener;
 use driver::units::ADC_MAX;
 
 /// EMG_SAMPLES_G0's id (hand.dbc): the frame that carries the sample counter first.
@@ -66,18 +65,34 @@ pub fn run(a: &RecordArgs) -> Result<(), CliError> {
     };
     std::fs::create_dir_all(&a.out).map_err(io_err(&a.out))?;
     let log_path = a.out.join(FRAMES_FILE);
-    let socket = open(&a.iface)?;
+    let mut socket = open(&a.iface)?;
+    if let Some((got, wanted)) = socket.small_rcvbuf() {
+        eprintln!(
+            "handctl record: the kernel granted a {got}-byte receive buffer of the {wanted} \
+             asked for: set net.core.rmem_max (README, install) or a slow disk may lose frames"
+        );
+    }
     eprintln!(
         "handctl record: {} for {:.1} s -> {}",
         a.iface,
         a.duration,
         log_path.display()
     );
-    let counts = record(&socket, &a.iface, &log_path, a.duration)?;
+    let counts = record(&mut socket, &a.iface, &log_path, a.duration)?;
+    let drops = socket.kernel_drops();
     eprintln!(
-        "handctl record: {} frames ({} error frames not logged)",
+        "handctl record: {} frames ({} error frames not logged), {drops} dropped by the kernel",
         counts.frames, counts.error_frames
     );
+    if drops > 0 {
+        // The log is kept (it is what was heard), but it is not the bus: refuse it.
+        return Err(CliError::Usage(format!(
+            "the kernel dropped {drops} frames because handctl record fell behind (its \
+             receive queue was full): {} has gaps. Record again with less load on the \
+             machine, or a larger net.core.rmem_max",
+            log_path.display()
+        )));
+    }
     if let Some(trials) = trials {
         let start_us = scenario_start(&counts)?;
         session_meta(&trials, start_us, a.mains).write(&a.out)?;
@@ -94,18 +109,18 @@ pub fn run(a: &RecordArgs) -> Result<(), CliError> {
     Ok(())
 }
 
-fn open(iface: &str) -> Result<CanSocket, CliError> {
+fn open(iface: &str) -> Result<Listener, CliError> {
     // A short timeout so the recording ends on time on a silent bus.
-    super::listen::open(iface, Duration::from_millis(50), true)
+    Listener::open(iface, Duration::from_millis(50), true)
 }
 
-fn record(sock: &CanSocket, iface: &str, path: &Path, seconds: f64) -> Result<Counts, CliError> {
+fn record(sock: &mut Listener, iface: &str, path: &Path, seconds: f64) -> Result<Counts, CliError> {
     let file = File::create(path).map_err(io_err(path))?;
     let mut log = LogWriter::new(BufWriter::new(file));
     let mut counts = Counts::default();
     let end = Instant::now() + Duration::from_secs_f64(seconds);
     while Instant::now() < end {
-        let (frame, time_us) = match super::listen::read(sock) {
+        let (f, time_us) = match sock.read_frame(&mut counts.error_frames) {
             Ok(Some(x)) => x,
             Ok(None) => continue,
             Err(source) => {
@@ -116,15 +131,6 @@ fn record(sock: &CanSocket, iface: &str, path: &Path, seconds: f64) -> Result<Co
                 })
             }
         };
-        let ours = match frame {
-            socketcan::CanFrame::Data(d) => CanFrame::new(d.id(), d.data()),
-            socketcan::CanFrame::Remote(r) => CanFrame::new_remote(r.id(), r.dlc()),
-            socketcan::CanFrame::Error(_) => {
-                counts.error_frames += 1;
-                continue;
-            }
-        };
-        let Some(f) = ours else { continue };
         if counts.first_emg.is_none() && f.raw_id() == EMG_G0_ID && f.data().len() >= 2 {
             counts.first_emg = Some((time_us, f.data()[1]));
         }

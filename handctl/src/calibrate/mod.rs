@@ -94,10 +94,12 @@ pub fn run(a: &CalibrateArgs) -> Result<(), CliError> {
     // From here on Ctrl-C ends the process at once (the model file is written atomically).
     stop.store(true, Ordering::Relaxed);
     out.say(&format!(
-        "session: {} trials kept in {} ({} frames logged, {} attempt(s) repeated); training",
+        "session: {} trials kept in {} ({} frames logged, {} dropped by the kernel, {} \
+         attempt(s) repeated); training",
         done.kept,
         a.out.display(),
         done.frames,
+        bus.kernel_drops(),
         done.repeats.len()
     ));
     let trained = training::train_session(&a.out, &a.training, a.tolerance, a.patient.as_deref())?;

@@ -4,32 +4,34 @@
 
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
+use crate::listen::Listener;
 use hand_dbc::CanFrame;
-use socketcan::{CanSocket, EmbeddedFrame, Socket, StandardId};
 
 use super::error::CalibrateError;
 use super::workflow::{Pace, Transport};
 
 /// The bus on SocketCAN.
 pub struct SocketBus {
-    sock: CanSocket,
+    sock: Listener,
     iface: String,
+    /// Error frames read (not the calibration's business: the daemon reports the bus state).
+    error_frames: u64,
 }
 
 impl SocketBus {
     /// Opens `iface` (checked up first), non-blocking, with receive timestamps.
     pub fn open(iface: &str) -> Result<Self, crate::error::CliError> {
-        let sock = crate::listen::open(iface, Duration::from_millis(1), false)?;
-        sock.set_nonblocking(true)
-            .map_err(|source| crate::error::CliError::Can {
-                iface: iface.to_owned(),
-                what: "cannot make it non-blocking".into(),
-                source,
-            })?;
+        let sock = Listener::open(iface, Duration::ZERO, false)?;
         Ok(SocketBus {
             sock,
             iface: iface.to_owned(),
+            error_frames: 0,
         })
+    }
+
+    /// Frames the kernel dropped because this socket fell behind.
+    pub fn kernel_drops(&self) -> u64 {
+        self.sock.kernel_drops()
     }
 
     fn err(&self, what: &str, e: impl std::fmt::Display) -> CalibrateError {
@@ -39,28 +41,13 @@ impl SocketBus {
 
 impl Transport for SocketBus {
     fn send(&mut self, frame: &CanFrame) -> Result<(), CalibrateError> {
-        let id = StandardId::new(frame.raw_id() as u16)
-            .ok_or_else(|| self.err("send", "not a standard id"))?;
-        let f = socketcan::CanFrame::new(id, frame.data())
-            .ok_or_else(|| self.err("send", "bad frame"))?;
-        self.sock.write_frame(&f).map_err(|e| self.err("send", e))
+        self.sock.send(frame).map_err(|e| self.err("send", e))
     }
 
     fn receive(&mut self) -> Result<Option<(CanFrame, u64)>, CalibrateError> {
-        loop {
-            let Some((frame, t)) =
-                crate::listen::read(&self.sock).map_err(|e| self.err("read", e))?
-            else {
-                return Ok(None);
-            };
-            let ours = match frame {
-                socketcan::CanFrame::Data(d) => CanFrame::new(d.id(), d.data()),
-                socketcan::CanFrame::Remote(r) => CanFrame::new_remote(r.id(), r.dlc()),
-                socketcan::CanFrame::Error(_) => None,
-            };
-            if let Some(f) = ours {
-                return Ok(Some((f, t)));
-            }
+        match self.sock.read_frame(&mut self.error_frames) {
+            Ok(x) => Ok(x),
+            Err(e) => Err(self.err("read", e)),
         }
     }
 }

@@ -9,10 +9,9 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc::SyncSender;
 use std::time::{Duration, Instant};
 
+use crate::listen::Listener;
 use driver::control::Subscription;
 use hand_dbc::candump::LogReader;
-use hand_dbc::CanFrame;
-use socketcan::{CanSocket, EmbeddedFrame};
 
 use super::feed::{Event, Monitor};
 use crate::error::CliError;
@@ -50,26 +49,24 @@ pub fn pump_daemon(subscription: Subscription, tx: SyncSender<Event>) {
 
 /// Opens `iface` for reading with kernel receive timestamps. A raw CAN socket that never
 /// writes: the monitor is listen-only on the bus.
-pub fn open_bus(iface: &str) -> Result<CanSocket, CliError> {
-    crate::listen::open(iface, Duration::from_millis(100), false)
+pub fn open_bus(iface: &str) -> Result<Listener, CliError> {
+    Listener::open(iface, Duration::from_millis(100), false)
 }
 
 /// Sends every data frame read from the bus, with its kernel receive time.
-pub fn pump_bus(sock: CanSocket, iface: String, tx: SyncSender<Event>) {
+pub fn pump_bus(mut sock: Listener, iface: String, tx: SyncSender<Event>) {
+    let mut error_frames = 0;
     let why = loop {
-        let (frame, t) = match crate::listen::read(&sock) {
+        let (f, t) = match sock.read_frame(&mut error_frames) {
             Ok(Some(x)) => x,
             Ok(None) => continue,
             Err(e) => break format!("reading {iface} failed: {e}"),
         };
-        let ours = match frame {
-            socketcan::CanFrame::Data(d) => CanFrame::new(d.id(), d.data()),
-            _ => None,
-        };
-        if let Some(f) = ours {
-            if tx.send(Event::Frame(t, f)).is_err() {
-                return;
-            }
+        if f.is_remote() {
+            continue;
+        }
+        if tx.send(Event::Frame(t, f)).is_err() {
+            return;
         }
     };
     let _ = tx.send(Event::End(why));

@@ -100,6 +100,26 @@ impl Proc {
         let _ = self.child.wait();
     }
 
+    /// Waits up to `limit` for the process to end by itself; its exit status.
+    pub fn wait_exit(&mut self, limit: Duration) -> std::process::ExitStatus {
+        let end = Instant::now() + limit;
+        loop {
+            match self.child.try_wait() {
+                Ok(Some(st)) => return st,
+                Ok(None) if Instant::now() < end => std::thread::sleep(Duration::from_millis(20)),
+                Ok(None) => {
+                    self.kill();
+                    panic!(
+                        "{} did not end within {limit:?}; its output:\n{}",
+                        self.name,
+                        self.output()
+                    );
+                }
+                Err(e) => panic!("waiting for {}: {e}", self.name),
+            }
+        }
+    }
+
     /// Waits up to `limit` for the process to end by itself and asserts it exited with 0.
     pub fn wait_success(&mut self, limit: Duration) {
         let end = Instant::now() + limit;
