@@ -10,7 +10,7 @@ use thiserror::Error;
 pub enum ErrorClass {
     /// 0x00xx: error reset or no error.
     NoError,
-    /// 0x10xx: generic error.
+    /// 0x10xx: generic error (0x11xx..0x1Fxx are reserved).
     Generic,
     /// 0x2xxx: current.
     Current,
@@ -41,7 +41,7 @@ impl ErrorClass {
     pub fn of(code: u16) -> Self {
         match code >> 12 {
             0 if code >> 8 == 0 => Self::NoError,
-            1 => Self::Generic,
+            1 if code >> 8 == 0x10 => Self::Generic,
             2 => Self::Current,
             3 => Self::Voltage,
             4 => Self::Temperature,
