@@ -14,6 +14,22 @@
 //! - [`scaling`]: daemon units to drive units, validated once.
 //! - [`startup`]: one drive's start-up as data and as a state machine.
 //! - [`sim`] (feature `sim`): a simulated CiA 402 drive node.
+//!
+//! ```
+//! use hand_canopen::sdo::{SdoDone, SdoReply};
+//! use hand_canopen::{NodeId, ObjectAddr, SdoClient, SdoData};
+//!
+//! let drive = NodeId::try_new(3)?;
+//! let vendor = ObjectAddr::new(0x1018, 1);
+//! let mut sdo = SdoClient::new(drive, 20_000);
+//! let request = sdo.upload(vendor, 0)?; // the caller sends this frame
+//! assert_eq!(request.cob_id(), 0x603);
+//! // The drive's answer arrives; the caller offers it with its own clock's `now`.
+//! let reply = SdoReply::Uploaded(vendor, SdoData::u32(0x1D)).frame(drive);
+//! assert_eq!(sdo.on_frame(&reply), Some(Ok(SdoDone::Uploaded(SdoData::u32(0x1D)))));
+//! assert!(sdo.poll(1_000_000).is_none(), "nothing in flight, nothing times out");
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 pub mod cia402;
 pub mod emcy;
