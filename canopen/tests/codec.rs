@@ -4,7 +4,9 @@ use hand_canopen::cia402::{
     transition_for, Cia402Error, Command, DriverStep, PowerDriver, STATE_TABLE, TRANSITIONS,
 };
 use hand_canopen::emcy::{meaning, Emcy, ErrorClass};
-use hand_canopen::heartbeat::{HeartbeatConsumer, HeartbeatEvent, HeartbeatStatus};
+use hand_canopen::heartbeat::{
+    HeartbeatConsumer, HeartbeatEvent, HeartbeatProducer, HeartbeatStatus,
+};
 use hand_canopen::ids::Function;
 use hand_canopen::nmt::{ErrorControl, NmtMessage, NMT_COMMANDS};
 use hand_canopen::pdo::{finger_pdos, Direction, PdoError, PDO_INVALID};
@@ -440,6 +442,17 @@ fn sync_and_heartbeat_follow_the_callers_clock() {
     // A late loop sends one SYNC, not a burst.
     assert!(s.poll(100_000).is_some());
     assert!(s.poll(100_001).is_none());
+
+    let mut p = HeartbeatProducer::new(node(100), 50_000);
+    assert_eq!(
+        p.poll(0, NmtState::Operational),
+        Some(frame(0x764, &[0x05]))
+    );
+    assert!(p.poll(49_999, NmtState::Operational).is_none());
+    assert_eq!(
+        p.poll(50_000, NmtState::PreOperational),
+        Some(frame(0x764, &[0x7F]))
+    );
 
     let mut c = HeartbeatConsumer::new();
     c.watch(node(3), 100);
