@@ -38,13 +38,42 @@ mod tests {
     #[test]
     fn edges_agree_with_std() {
         let edges = [
-            0.0, -0.0, 0.5, -0.5, 1.5, -1.5, 2.5, -2.5, 0.49999999999999994, -0.49999999999999994,
-            4503599627370495.5, -4503599627370495.5, WHOLE_FROM, 1e300, -1e300, f64::MAX, f64::MIN,
-            f64::INFINITY, f64::NEG_INFINITY, 2047.4999, -2048.5, 1e-320,
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            -2.5,
+            0.49999999999999994,
+            -0.49999999999999994,
+            4503599627370495.5,
+            -4503599627370495.5,
+            WHOLE_FROM,
+            1e300,
+            -1e300,
+            f64::MAX,
+            f64::MIN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            2047.4999,
+            -2048.5,
+            1e-320,
         ];
         for x in edges {
-            assert!(round(x) == x.round(), "round({x:e}) = {} vs std {}", round(x), x.round());
-            assert!(trunc(x) == x.trunc(), "trunc({x:e}) = {} vs std {}", trunc(x), x.trunc());
+            assert!(
+                round(x) == x.round(),
+                "round({x:e}) = {} vs std {}",
+                round(x),
+                x.round()
+            );
+            assert!(
+                trunc(x) == x.trunc(),
+                "trunc({x:e}) = {} vs std {}",
+                trunc(x),
+                x.trunc()
+            );
         }
         assert!(round(f64::NAN).is_nan() && trunc(f64::NAN).is_nan());
     }
