@@ -127,10 +127,10 @@ mod tests {
                 clipped: true
             }
         );
-        // Half an LSB (1.25 µV) rounds away from zero: at gain 8, 1.25 µV is 18641.13 codes.
-        assert!(s.to_bus(Code::new(18_642).expect("24 bit")).raw == 1);
-        assert!(s.to_bus(Code::new(-18_642).expect("24 bit")).raw == -1);
-        assert!(s.to_bus(Code::new(18_641).expect("24 bit")).raw == 0);
+        // Half an LSB (1.25 µV) rounds away from zero: at gain 8, 1.25 µV is 18.64 codes.
+        assert!(s.to_bus(Code::new(19).expect("24 bit")).raw == 1);
+        assert!(s.to_bus(Code::new(-19).expect("24 bit")).raw == -1);
+        assert!(s.to_bus(Code::new(18).expect("24 bit")).raw == 0);
         assert!((s.uv_per_code() - 0.067_055_225_372_314_45).abs() < 1e-15);
     }
 }
