@@ -46,13 +46,17 @@ impl<SPI: SpiDevice> Ads1299<SPI> {
         Ok(())
     }
 
-    /// Writes `values` to consecutive registers from `start` (WREG), tSDECODE between bytes.
+    /// Writes `values` to consecutive registers from `start` (WREG), tSDECODE between bytes;
+    /// 1 to 17 registers (the longest writable block), else [`Error::Length`].
     pub fn write_registers(&mut self, start: u8, values: &[u8]) -> Result<(), Error<SPI::Error>> {
-        let n = values.len().min(BLOCK_A_LEN);
+        let n = values.len();
+        if n == 0 || n > BLOCK_A_LEN {
+            return Err(Error::Length { len: n });
+        }
         let mut bytes = [0u8; MAX_COMMAND];
         bytes[0] = command::WREG | (start & 0x1F);
-        bytes[1] = (n.saturating_sub(1) as u8) & 0x1F;
-        bytes[2..2 + n].copy_from_slice(&values[..n]);
+        bytes[1] = (n - 1) as u8;
+        bytes[2..2 + n].copy_from_slice(values);
         let mut ops: [Operation<'_, u8>; MAX_OPS] = core::array::from_fn(|_| Operation::DelayNs(0));
         let mut k = 0;
         for (i, b) in bytes[..2 + n].chunks(1).enumerate() {
@@ -68,20 +72,21 @@ impl<SPI: SpiDevice> Ads1299<SPI> {
         Ok(())
     }
 
-    /// Reads consecutive registers from `start` into `out` (RREG), tSDECODE between bytes.
+    /// Reads consecutive registers from `start` into `out` (RREG), tSDECODE between bytes; 1 to
+    /// 17 registers, else [`Error::Length`].
     pub fn read_registers(&mut self, start: u8, out: &mut [u8]) -> Result<(), Error<SPI::Error>> {
-        let n = out.len().min(BLOCK_A_LEN);
-        let opcode = [
-            command::RREG | (start & 0x1F),
-            (n.saturating_sub(1) as u8) & 0x1F,
-        ];
+        let n = out.len();
+        if n == 0 || n > BLOCK_A_LEN {
+            return Err(Error::Length { len: n });
+        }
+        let opcode = [command::RREG | (start & 0x1F), (n - 1) as u8];
         let mut ops: [Operation<'_, u8>; MAX_OPS] = core::array::from_fn(|_| Operation::DelayNs(0));
         ops[0] = Operation::Write(&opcode[..1]);
         ops[1] = Operation::DelayNs(T_SDECODE_NS);
         ops[2] = Operation::Write(&opcode[1..]);
         ops[3] = Operation::DelayNs(T_SDECODE_NS);
         let mut k = 4;
-        for (i, b) in out[..n].chunks_mut(1).enumerate() {
+        for (i, b) in out.chunks_mut(1).enumerate() {
             ops[k] = Operation::Read(b);
             ops[k + 1] = Operation::DelayNs(if i + 1 < n { T_SDECODE_NS } else { T_SCCS_NS });
             k += 2;

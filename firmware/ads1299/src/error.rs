@@ -25,6 +25,11 @@ pub enum Error<E> {
     DrdyTimeout,
     /// The DRDY pin could not be read.
     DrdyPin,
+    /// A register command for 0 or more than 17 registers (the longest writable block).
+    Length {
+        /// The number of registers asked for.
+        len: usize,
+    },
     /// A data frame whose status word does not start with the 1100 header (a read out of
     /// step with the conversions, or a chip that lost its configuration).
     BadHeader {
@@ -45,10 +50,11 @@ impl<E: fmt::Debug> fmt::Display for Error<E> {
             Self::Spi(e) => write!(f, "SPI transaction failed: {e:?}"),
             Self::WrongId { found } => write!(
                 f,
-                "ID register reads {found:#04x}, not an 8-channel ADS1299 (x{:02x} with the \
-                 revision bits)",
+                "ID register reads {found:#04x}, not an 8-channel ADS1299 ({:#04x} under the \
+                 revision bits 7:5)",
                 crate::registers::id::EXPECTED_8CH
             ),
+            Self::Length { len } => write!(f, "{len} registers in one command: 1 to 17"),
             Self::Verify {
                 address,
                 wrote,

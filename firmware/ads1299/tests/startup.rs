@@ -243,5 +243,8 @@ fn spi_errors_are_named() {
     assert!(adc.init(&first_chip()) == Err(Error::Spi(ErrorKind::Overrun)));
     assert!(adc.read_frame() == Err(Error::Spi(ErrorKind::Overrun)));
     let shown = format!("{}", Error::<ErrorKind>::WrongId { found: 0x92 });
-    assert!(shown.contains("0x92"), "{shown}");
+    assert!(shown.contains("0x92") && shown.contains("0x1e"), "{shown}");
+    // Register commands outside 1..=17 registers are refused before any SPI traffic.
+    assert!(adc.write_registers(0x01, &[0; 18]) == Err(Error::Length { len: 18 }));
+    assert!(adc.read_registers(0x01, &mut []) == Err(Error::Length { len: 0 }));
 }
