@@ -6,8 +6,8 @@
 //! CRC, delimiters, ACK, EOF and interframe space; of these, the 34 + 8*DLC bits from SOF to
 //! the CRC are subject to stuffing, at worst one stuff bit per 4 bits after the first).
 
-use crate::info::MessageInfo;
 use crate::messages::MESSAGES;
+use crate::MessageInfo;
 
 /// Nominal bit rate of the hand bus.
 pub const BITRATE_BPS: f64 = 1_000_000.0;

@@ -13,7 +13,7 @@ use std::path::Path;
 
 use embedded_can::{ExtendedId, StandardId};
 
-use crate::frame::CanFrame;
+use crate::CanFrame;
 
 /// Longest line accepted, bytes (without its newline). The longest valid line, a 20-digit
 /// timestamp, a 15-character interface and an extended frame of 8 bytes, is under 70 bytes.

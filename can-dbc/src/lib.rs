@@ -3,7 +3,7 @@
 //!
 //! - [`messages`]: message types generated from hand.dbc by `hand-dbc-codegen`
 //!   (`cargo run -p hand-dbc-codegen --bin hand-dbc-gen`) into the checked-in module
-//!   `src/messages/generated.rs`, with the [`messages::decode`] dispatcher and
+//!   `core/src/messages/generated.rs`, with the [`messages::decode`] dispatcher and
 //!   [`messages::Message`].
 //! - [`hand`]: the hand's constants from the DBC: [`hand::N_FINGERS`], [`hand::FINGER_NAMES`]
 //!   (0 thumb .. 4 pinky), [`hand::finger_index`], the EMG ADC rails [`hand::ADC_MIN`] and
@@ -15,6 +15,11 @@
 //!   and offline session loading share.
 //! - [`busload`]: worst-case bus load computed from the DBC.
 //! - [`candump`]: can-utils log reading and writing.
+//!
+//! The codec itself (`messages`, `e2e`, `emg`, `hand`, [`CanFrame`]) lives in the no_std,
+//! no-alloc crate `hand-dbc-core` (`can-dbc/core`), which the amplifier node's firmware builds
+//! too; this crate re-exports it unchanged, so `hand_dbc::messages::...` and the rest keep
+//! their paths, and adds the host-side parts (`emg_front`, `busload`, `candump`).
 //!
 //! Nothing here knows sockets, threads or clocks: the same code runs in the daemon, the
 //! simulator, offline evaluation and replay.
@@ -44,15 +49,7 @@
 
 pub mod busload;
 pub mod candump;
-pub mod e2e;
-pub mod emg;
 pub mod emg_front;
-mod error;
-mod frame;
-pub mod hand;
-mod info;
-pub mod messages;
 
-pub use error::CodecError;
-pub use frame::{CanFrame, MAX_DLC};
-pub use info::{MessageInfo, SignalInfo};
+pub use hand_dbc_core::{e2e, emg, hand, messages};
+pub use hand_dbc_core::{CanFrame, CodecError, MessageInfo, SignalInfo, MAX_DLC};

@@ -10,7 +10,7 @@ use crate::{format, generate, GenError};
 pub struct Paths {
     /// The bus definition (`can-dbc/hand.dbc`).
     pub dbc: PathBuf,
-    /// The checked-in codec (`can-dbc/src/messages/generated.rs`).
+    /// The checked-in codec (`can-dbc/core/src/messages/generated.rs`).
     pub output: PathBuf,
     /// The workspace's `rustfmt.toml`.
     pub rustfmt_config: PathBuf,
@@ -24,7 +24,7 @@ impl Paths {
             .expect("the codegen crate lives in can-dbc/codegen");
         Self {
             dbc: can_dbc.join("hand.dbc"),
-            output: can_dbc.join("src/messages/generated.rs"),
+            output: can_dbc.join("core/src/messages/generated.rs"),
             rustfmt_config: can_dbc.join("../rustfmt.toml"),
         }
     }

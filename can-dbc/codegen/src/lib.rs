@@ -1,5 +1,5 @@
 //! The generator of hand-dbc's message codec: reads `can-dbc/hand.dbc` and writes the
-//! checked-in Rust module `can-dbc/src/messages/generated.rs`, so the code a safety bus depends
+//! checked-in Rust module `can-dbc/core/src/messages/generated.rs`, so the code a safety bus depends
 //! on is reviewed like any other source file.
 //!
 //! Two steps, each in its own place:

@@ -1,4 +1,4 @@
-//! The checked-in `can-dbc/src/messages/generated.rs` is exactly what hand.dbc generates now.
+//! The checked-in `can-dbc/core/src/messages/generated.rs` is exactly what hand.dbc generates now.
 
 use hand_dbc_codegen::files::{regenerate, Paths};
 use hand_dbc_codegen::REGENERATE;

@@ -1,4 +1,4 @@
-//! `hand-dbc-gen [--check]`: regenerates `can-dbc/src/messages/generated.rs` from
+//! `hand-dbc-gen [--check]`: regenerates `can-dbc/core/src/messages/generated.rs` from
 //! `can-dbc/hand.dbc`; with `--check`, only reports whether the checked-in file is current.
 
 use std::process::ExitCode;

@@ -101,7 +101,7 @@ let tol = {};
 if !value.is_finite() || value < Self::{up}_MIN - tol || value > Self::{up}_MAX + tol {{
 {refuse}
 }}
-let raw = ((value - {}) / {}).round() as i64;
+let raw = round((value - {}) / {}) as i64;
 if !({}..={}).contains(&raw) {{ {refuse} }}
 self.{f} = raw as {};
 Ok(())

@@ -16,9 +16,9 @@ mod structure;
 
 use crate::model::{Bus, Group, Kind, Signal};
 
-/// What the generated module needs from its parent (`hand_dbc::messages`) and the crate.
+/// What the generated module needs from its parent (`hand_dbc_core::messages`) and the crate.
 const PRELUDE: &str = "\
-use super::{standard_data_frame, to_can_frame, whole};
+use super::{round, standard_data_frame, to_can_frame, whole};
 use crate::e2e::E2eProfile;
 use crate::error::CodecError;
 use crate::frame::CanFrame;

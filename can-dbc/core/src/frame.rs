@@ -14,7 +14,7 @@ pub const MAX_DLC: usize = 8;
 /// A classic CAN 2.0 frame: 11- or 29-bit id, 0..=8 data bytes, or a remote request.
 ///
 /// The receive time is deliberately not part of the frame: it belongs to whoever received it
-/// (see [`crate::candump::LogEntry`]).
+/// (see `hand_dbc::candump::LogEntry`).
 #[derive(Clone, Copy, PartialEq, Eq, Hash)]
 pub struct CanFrame {
     id: Id,

@@ -27,11 +27,11 @@ pub const ADC_MAX: i16 = EmgSamplesG0::EMG0_RAW_MAX;
 /// The index of a finger from its name (`"index"`, any case, surrounding blanks ignored) or its
 /// number (`"1"`).
 pub fn finger_index(name: &str) -> Option<usize> {
-    let lower = name.trim().to_ascii_lowercase();
+    let name = name.trim();
     FINGER_NAMES
         .iter()
-        .position(|n| *n == lower)
-        .or_else(|| lower.parse::<usize>().ok().filter(|&i| i < N_FINGERS))
+        .position(|n| n.eq_ignore_ascii_case(name))
+        .or_else(|| name.parse::<usize>().ok().filter(|&i| i < N_FINGERS))
 }
 
 /// Whether a raw EMG sample sits on an ADC rail (equal to [`ADC_MIN`] or [`ADC_MAX`]).

@@ -2,7 +2,7 @@
 // Do not edit by hand: edit hand.dbc and rerun that command. Add `-- --check` to only
 // compare; `cargo test -p hand-dbc-codegen` fails while this file is out of date.
 
-use super::{standard_data_frame, to_can_frame, whole};
+use super::{round, standard_data_frame, to_can_frame, whole};
 use crate::e2e::E2eProfile;
 use crate::error::CodecError;
 use crate::frame::CanFrame;
@@ -1117,7 +1117,7 @@ impl EmgSamplesG0 {
                 unit: "uV",
             });
         }
-        let raw = ((value - 0.0) / 2.5).round() as i64;
+        let raw = round((value - 0.0) / 2.5) as i64;
         if !(-2048..=2047).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -1170,7 +1170,7 @@ impl EmgSamplesG0 {
                 unit: "uV",
             });
         }
-        let raw = ((value - 0.0) / 2.5).round() as i64;
+        let raw = round((value - 0.0) / 2.5) as i64;
         if !(-2048..=2047).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -1223,7 +1223,7 @@ impl EmgSamplesG0 {
                 unit: "uV",
             });
         }
-        let raw = ((value - 0.0) / 2.5).round() as i64;
+        let raw = round((value - 0.0) / 2.5) as i64;
         if !(-2048..=2047).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -1276,7 +1276,7 @@ impl EmgSamplesG0 {
                 unit: "uV",
             });
         }
-        let raw = ((value - 0.0) / 2.5).round() as i64;
+        let raw = round((value - 0.0) / 2.5) as i64;
         if !(-2048..=2047).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -1611,7 +1611,7 @@ impl EmgSamplesG1 {
                 unit: "uV",
             });
         }
-        let raw = ((value - 0.0) / 2.5).round() as i64;
+        let raw = round((value - 0.0) / 2.5) as i64;
         if !(-2048..=2047).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -1664,7 +1664,7 @@ impl EmgSamplesG1 {
                 unit: "uV",
             });
         }
-        let raw = ((value - 0.0) / 2.5).round() as i64;
+        let raw = round((value - 0.0) / 2.5) as i64;
         if !(-2048..=2047).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -1717,7 +1717,7 @@ impl EmgSamplesG1 {
                 unit: "uV",
             });
         }
-        let raw = ((value - 0.0) / 2.5).round() as i64;
+        let raw = round((value - 0.0) / 2.5) as i64;
         if !(-2048..=2047).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -1770,7 +1770,7 @@ impl EmgSamplesG1 {
                 unit: "uV",
             });
         }
-        let raw = ((value - 0.0) / 2.5).round() as i64;
+        let raw = round((value - 0.0) / 2.5) as i64;
         if !(-2048..=2047).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -2105,7 +2105,7 @@ impl EmgSamplesG2 {
                 unit: "uV",
             });
         }
-        let raw = ((value - 0.0) / 2.5).round() as i64;
+        let raw = round((value - 0.0) / 2.5) as i64;
         if !(-2048..=2047).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -2158,7 +2158,7 @@ impl EmgSamplesG2 {
                 unit: "uV",
             });
         }
-        let raw = ((value - 0.0) / 2.5).round() as i64;
+        let raw = round((value - 0.0) / 2.5) as i64;
         if !(-2048..=2047).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -2211,7 +2211,7 @@ impl EmgSamplesG2 {
                 unit: "uV",
             });
         }
-        let raw = ((value - 0.0) / 2.5).round() as i64;
+        let raw = round((value - 0.0) / 2.5) as i64;
         if !(-2048..=2047).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -2264,7 +2264,7 @@ impl EmgSamplesG2 {
                 unit: "uV",
             });
         }
-        let raw = ((value - 0.0) / 2.5).round() as i64;
+        let raw = round((value - 0.0) / 2.5) as i64;
         if !(-2048..=2047).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -3070,7 +3070,7 @@ impl FingerSetpoint {
                 unit: "N",
             });
         }
-        let raw = ((value - 0.0) / 0.01).round() as i64;
+        let raw = round((value - 0.0) / 0.01) as i64;
         if !(-5000..=5000).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAMES[usize::from(self.instance)],
@@ -3126,7 +3126,7 @@ impl FingerSetpoint {
                 unit: "rad/s",
             });
         }
-        let raw = ((value - 0.0) / 0.001).round() as i64;
+        let raw = round((value - 0.0) / 0.001) as i64;
         if !(-20000..=20000).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAMES[usize::from(self.instance)],
@@ -3581,7 +3581,7 @@ impl FingerStatus {
                 unit: "rad",
             });
         }
-        let raw = ((value - -0.5) / 0.001).round() as i64;
+        let raw = round((value - -0.5) / 0.001) as i64;
         if !(0..=2500).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAMES[usize::from(self.instance)],
@@ -3637,7 +3637,7 @@ impl FingerStatus {
                 unit: "rad/s",
             });
         }
-        let raw = ((value - 0.0) / 0.01).round() as i64;
+        let raw = round((value - 0.0) / 0.01) as i64;
         if !(-2000..=2000).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAMES[usize::from(self.instance)],
@@ -3690,7 +3690,7 @@ impl FingerStatus {
                 unit: "N",
             });
         }
-        let raw = ((value - 0.0) / 0.025).round() as i64;
+        let raw = round((value - 0.0) / 0.025) as i64;
         if !(-2000..=2000).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAMES[usize::from(self.instance)],
@@ -4449,7 +4449,7 @@ impl HandDiag {
                 unit: "1",
             });
         }
-        let raw = ((value - 0.0) / 0.05).round() as i64;
+        let raw = round((value - 0.0) / 0.05) as i64;
         if !(-20..=20).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -4502,7 +4502,7 @@ impl HandDiag {
                 unit: "1",
             });
         }
-        let raw = ((value - 0.0) / 0.05).round() as i64;
+        let raw = round((value - 0.0) / 0.05) as i64;
         if !(-20..=20).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -4555,7 +4555,7 @@ impl HandDiag {
                 unit: "1",
             });
         }
-        let raw = ((value - 0.0) / 0.05).round() as i64;
+        let raw = round((value - 0.0) / 0.05) as i64;
         if !(-20..=20).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -4608,7 +4608,7 @@ impl HandDiag {
                 unit: "1",
             });
         }
-        let raw = ((value - 0.0) / 0.05).round() as i64;
+        let raw = round((value - 0.0) / 0.05) as i64;
         if !(-20..=20).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -4661,7 +4661,7 @@ impl HandDiag {
                 unit: "1",
             });
         }
-        let raw = ((value - 0.0) / 0.05).round() as i64;
+        let raw = round((value - 0.0) / 0.05) as i64;
         if !(-20..=20).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,
@@ -5207,7 +5207,7 @@ impl CalibrationCue {
                 unit: "s",
             });
         }
-        let raw = ((value - 0.0) / 0.01).round() as i64;
+        let raw = round((value - 0.0) / 0.01) as i64;
         if !(0..=65535).contains(&raw) {
             return Err(CodecError::OutOfRange {
                 message: Self::NAME,

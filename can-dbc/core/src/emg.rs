@@ -441,7 +441,7 @@ impl EmgAssembler {
             counter: next,
             raw,
             bridged_groups,
-            after_gap: std::mem::take(&mut self.pending_gap),
+            after_gap: core::mem::take(&mut self.pending_gap),
             received_us,
         };
         self.seq += 1;

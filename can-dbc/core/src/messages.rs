@@ -1,6 +1,6 @@
 //! The message types of hand.dbc. The code is generated from hand.dbc by the
 //! `hand-dbc-codegen` crate (`can-dbc/codegen`) into the checked-in, reviewed module
-//! `src/messages/generated.rs`: edit hand.dbc, run
+//! `core/src/messages/generated.rs`: edit hand.dbc, run
 //! `cargo run -p hand-dbc-codegen --bin hand-dbc-gen`, and commit both; never edit the
 //! generated file. `cargo test -p hand-dbc-codegen` fails while it is out of date.
 //!
@@ -17,6 +17,8 @@
 //! decoded: the codec never wraps and never saturates.
 
 use embedded_can::{Frame, Id};
+
+pub(crate) use crate::num::round;
 
 pub use crate::error::CodecError;
 pub use crate::info::{MessageInfo, SignalInfo};
@@ -48,7 +50,7 @@ fn to_can_frame<F: Frame>(id: u32, data: &[u8]) -> Result<F, CodecError> {
 /// A whole number from a by-name physical value (for integer and enum signals).
 fn whole(message: &'static str, signal: &'static str, value: f64) -> Result<i64, CodecError> {
     // 2^63 bounds: every integer signal of hand.dbc is far narrower.
-    if !value.is_finite() || value.fract() != 0.0 || value.abs() >= 9.2e18 {
+    if !value.is_finite() || crate::num::trunc(value) != value || value.abs() >= 9.2e18 {
         return Err(CodecError::NotInteger {
             message,
             signal,

@@ -270,6 +270,13 @@ impl E2eProtector {
         self.next_counter
     }
 
+    /// Sets the counter the next protected frame carries (masked to the counter's width). A
+    /// sender that skipped samples (the amplifier node dropping whole samples on a full
+    /// transmit queue) jumps its counter by as many, so the receiver sees the gap.
+    pub fn set_next_counter(&mut self, counter: u8) {
+        self.next_counter = counter & self.profile.counter_mask();
+    }
+
     /// Writes the next counter into byte 1 (other bits of byte 1 kept) and the CRC into byte 0,
     /// then advances the counter (wrapping at 16 or 256, as AUTOSAR counters do). Returns the
     /// counter written.
