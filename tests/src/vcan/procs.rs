@@ -122,30 +122,13 @@ impl Proc {
 
     /// Waits up to `limit` for the process to end by itself and asserts it exited with 0.
     pub fn wait_success(&mut self, limit: Duration) {
-        let end = Instant::now() + limit;
-        loop {
-            match self.child.try_wait() {
-                Ok(Some(st)) => {
-                    assert!(
-                        st.success(),
-                        "{} ended with {st}; its output:\n{}",
-                        self.name,
-                        self.output()
-                    );
-                    return;
-                }
-                Ok(None) if Instant::now() < end => std::thread::sleep(Duration::from_millis(20)),
-                Ok(None) => {
-                    self.kill();
-                    panic!(
-                        "{} did not end within {limit:?}; its output:\n{}",
-                        self.name,
-                        self.output()
-                    );
-                }
-                Err(e) => panic!("waiting for {}: {e}", self.name),
-            }
-        }
+        let st = self.wait_exit(limit);
+        assert!(
+            st.success(),
+            "{} ended with {st}; its output:\n{}",
+            self.name,
+            self.output()
+        );
     }
 }
 
