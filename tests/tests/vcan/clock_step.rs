@@ -16,8 +16,9 @@ use hand_dbc::messages::{FingerMode, HandEstop};
 use handstack_tests::vcan::monitor::now_us;
 use handstack_tests::vcan::{first_safe_stop_after, setpoints_of};
 
+use super::arming::Armed;
 use super::restart::{send_estop, wait_active_after};
-use super::{Rig, ALL, ARM_BAR_US, DRILL_SILENCE_MS, SAFE_STOP_BAR_US};
+use super::{Rig, ALL, DRILL_SILENCE_MS, SAFE_STOP_BAR_US};
 
 const HOUR_S: i64 = 3_600;
 
@@ -137,19 +138,10 @@ fn field_clock_steps_keep_handd_running_and_reacting() {
         stop - onset
     );
 
-    let armed = now_us();
-    let sock = rig.cfg.socket.display().to_string();
-    handstack_tests::vcan::procs::handctl(
-        &rig.env,
-        &["arm", "--force-rest-mismatch", "--socket", &sock],
-    );
-    let resumed = wait_active_after(&rig.monitor, armed, Duration::from_secs(3))
+    let armed = Armed::now(&rig.env, &rig.cfg.socket);
+    let resumed = wait_active_after(&rig.monitor, armed.sent_us, Duration::from_secs(3))
         .expect("clock +1 h: never ACTIVE again after `handctl arm`");
-    assert!(
-        resumed - armed <= ARM_BAR_US,
-        "clock +1 h: ACTIVE {} us after arm",
-        resumed - armed
-    );
+    armed.check("clock +1 h", resumed);
     std::thread::sleep(Duration::from_millis(500));
 
     // Amplifier silence: handsim (the amplifier and the finger controllers) stops.

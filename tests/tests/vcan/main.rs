@@ -6,6 +6,7 @@
 //! Times are kernel receive timestamps of a monitor socket; handsim's scenario time 0 is the
 //! receive time of its first EMG sample (counter 0), so fault onsets are placed on the bus.
 
+mod arming;
 mod calibrate;
 mod clock_step;
 mod deploy;
@@ -27,6 +28,8 @@ use hand_model::patient::{Target, TrackingConfig};
 use handstack_tests::vcan::monitor::{now_us, writer};
 use handstack_tests::vcan::procs::{handctl, handsim, DEADLINE_SLACK_MS};
 use handstack_tests::vcan::replay::replay_tape;
+
+use arming::Armed;
 use handstack_tests::vcan::{
     first_safe_stop_after, scenario_start_us, setpoints_of, statuses_of, Monitor, Proc, Seen,
     TestConfig, VcanEnv,
@@ -464,13 +467,9 @@ const RUN_S: f64 = 5.0;
 /// When a latched drill runs `handctl arm` (scenario time): 0.6 s after the fault ended, so
 /// the recovery period it restarts ends well before the scenario does.
 const ARM_US: u64 = 3_600_000;
-/// Arming restarts the recovery time (the hand moves only after a full good period), so
-/// ACTIVE setpoints come back no sooner than this after `handctl arm`...
-const ARM_MIN_US: u64 = 500_000;
-/// ... and no later than this: the recovery time, plus the tick that applies the command and
-/// the tick that sees the period complete, plus starting handctl and its way to the daemon
-/// under emulation (measured 565-686 ms in all).
-const ARM_BAR_US: u64 = 900_000;
+/// An error-passive report is transient: ACTIVE again by itself at most this long after the
+/// controller is error-active again (the 500 ms recovery time plus two ticks and emulation).
+const RECOVERY_BAR_US: u64 = 900_000;
 
 /// Runs one handsim-injected fault and checks time to safe stop and the recovery rule.
 fn drill(d: &Drill<'_>) {
@@ -507,7 +506,7 @@ fn check_stop(
     onset: u64,
     fault_end: u64,
     end: u64,
-    armed: Option<u64>,
+    armed: Option<Armed>,
 ) {
     assert!(
         active_between(sps, onset - 500_000, onset) > 0,
@@ -556,22 +555,16 @@ fn check_stop(
         .next();
     if d.latched {
         let armed = armed.expect("a latched drill arms the daemon");
+        let r =
+            resumed.unwrap_or_else(|| panic!("{}: never ACTIVE again after `handctl arm`", d.name));
         assert!(
-            resumed.is_some_and(|r| r >= armed),
-            "{}: a latched fault cleared without arm (ACTIVE again before it, or never after)",
+            r >= armed.sent_us,
+            "{}: a latched fault cleared without arm (ACTIVE again before it)",
             d.name
         );
-        let r = resumed.unwrap_or(armed);
-        println!(
-            "drill {}: stays stopped until `handctl arm`; ACTIVE again {:.1} ms after it",
-            d.name,
-            (r - armed) as f64 * 1e-3
-        );
-        assert!(
-            (ARM_MIN_US..=ARM_BAR_US).contains(&(r - armed)),
-            "{}: ACTIVE {} us after `handctl arm` (expected {ARM_MIN_US} to {ARM_BAR_US})",
-            d.name,
-            r - armed
+        armed.check(
+            &format!("drill {} (stays stopped until `handctl arm`)", d.name),
+            r,
         );
     } else {
         let r =
@@ -672,7 +665,7 @@ fn d6_bus_off_error_frame() {
     // reopen, every setpoint after it is a safe stop, and the first within the bar.
     let after: Vec<_> = sps
         .iter()
-        .filter(|s| s.time_us > onset && s.time_us < armed)
+        .filter(|s| s.time_us > onset && s.time_us < armed.sent_us)
         .collect();
     assert!(
         after
@@ -683,18 +676,10 @@ fn d6_bus_off_error_frame() {
     );
     let resumed = sps
         .iter()
-        .find(|s| s.time_us >= armed && s.mode == FingerMode::Active)
+        .find(|s| s.time_us >= armed.sent_us && s.mode == FingerMode::Active)
         .map(|s| s.time_us)
         .expect("bus-off: never ACTIVE again after `handctl arm`");
-    println!(
-        "drill bus-off: ACTIVE again {:.1} ms after `handctl arm`",
-        (resumed - armed) as f64 * 1e-3
-    );
-    assert!(
-        (ARM_MIN_US..=ARM_BAR_US).contains(&(resumed - armed)),
-        "bus-off: ACTIVE {} us after `handctl arm` (expected {ARM_MIN_US} to {ARM_BAR_US})",
-        resumed - armed
-    );
+    armed.check("drill bus-off", resumed);
     let first = after
         .first()
         .map(|s| s.time_us)
@@ -777,8 +762,8 @@ fn d6b_error_passive_is_transient() {
         stopped - onset
     );
     assert!(
-        resumed - back_at <= ARM_BAR_US,
-        "error-passive: ACTIVE {} us after error-active (bar {ARM_BAR_US})",
+        resumed - back_at <= RECOVERY_BAR_US,
+        "error-passive: ACTIVE {} us after error-active (bar {RECOVERY_BAR_US})",
         resumed - back_at
     );
     assert_eq!(status.bus.controller, "error_active");
@@ -1020,19 +1005,11 @@ fn f_bad_input_flood_keeps_the_deadline() {
 }
 
 /// Runs `handctl arm` against the rig's daemon at bus time `at_us`; returns when it was sent.
-fn arm_at(rig: &Rig, at_us: u64) -> u64 {
+fn arm_at(rig: &Rig, at_us: u64) -> Armed {
     while now_us() < at_us {
         std::thread::sleep(Duration::from_millis(2));
     }
-    let sent = now_us();
-    let sock = rig.cfg.socket.display().to_string();
-    // The sine patient moves from its first sample, never at rest: the rest check before
-    // arm (driver/tests/rest_check.rs) is overridden here, as a technician would, audited.
-    handctl(
-        &rig.env,
-        &["arm", "--force-rest-mismatch", "--socket", &sock],
-    );
-    sent
+    Armed::now(&rig.env, &rig.cfg.socket)
 }
 
 /// Waits until handsim's first EMG sample is on the bus; its receive time (the scenario's 0).

@@ -11,11 +11,11 @@ use std::time::{Duration, Instant};
 
 use hand_dbc::messages::{EstopReason, EstopRequest, EstopSource, FingerMode, HandEstop};
 use handstack_tests::vcan::monitor::{now_us, writer};
-use handstack_tests::vcan::procs::handctl;
 use handstack_tests::vcan::{setpoints_of, Monitor};
 use socketcan::{EmbeddedFrame, Socket};
 
-use super::{Rig, ARM_BAR_US};
+use super::arming::Armed;
+use super::Rig;
 
 /// How long each restarted daemon is watched before it is armed: several ticks past the
 /// ~500 ms in which a daemon without latches would already run again.
@@ -148,28 +148,15 @@ fn assert_held(rig: &Rig, case: &str, killed_at: u64, fault: &str) {
 /// ACTIVE setpoints follow within the arm bar and that nothing was ACTIVE since `killed_at`
 /// before it.
 fn arm_and_run(rig: &Rig, case: &str, killed_at: u64) {
-    let armed = now_us();
-    let sock = rig.cfg.socket.display().to_string();
-    handctl(
-        &rig.env,
-        &["arm", "--force-rest-mismatch", "--socket", &sock],
-    );
+    let armed = Armed::now(&rig.env, &rig.cfg.socket);
     let resumed = wait_active_after(&rig.monitor, killed_at, Duration::from_secs(3))
         .unwrap_or_else(|| panic!("{case}: never ACTIVE again after `handctl arm`"));
     assert!(
-        resumed >= armed,
+        resumed >= armed.sent_us,
         "{case}: ACTIVE {} us before `handctl arm`",
-        armed - resumed
+        armed.sent_us - resumed
     );
-    println!(
-        "restart after SIGKILL ({case}): ACTIVE {:.1} ms after `handctl arm`",
-        (resumed - armed) as f64 * 1e-3
-    );
-    assert!(
-        resumed - armed <= ARM_BAR_US,
-        "{case}: ACTIVE {} us after `handctl arm` (bar {ARM_BAR_US})",
-        resumed - armed
-    );
+    armed.check(&format!("restart after SIGKILL ({case})"), resumed);
 }
 
 #[test]
