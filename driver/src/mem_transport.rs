@@ -48,6 +48,11 @@ impl<K: Clock> MemTransport<K> {
         }
     }
 
+    /// Frames received and not read yet.
+    pub fn pending(&self) -> usize {
+        self.endpoint.pending()
+    }
+
     /// Frames dropped because the receive queue was full (the bus's lost frames).
     pub fn overflows(&self) -> u64 {
         self.endpoint.overflows()

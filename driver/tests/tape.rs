@@ -16,6 +16,7 @@ use driver::mem_transport::MemTransport;
 use driver::safety::DaemonState;
 use driver::tape::{self, End, Entry, TapeWriter};
 use driver::FingerGains;
+use hand_dbc::messages::FingerMode;
 use hand_dbc::CanFrame;
 use hand_model::faults::{CrcTarget, Fault, FaultPlan};
 use hand_model::patient::Script;
@@ -226,4 +227,89 @@ fn a_cut_off_or_foreign_file_is_refused_or_read_up_to_the_cut() {
     std::fs::write(&path, format!("{}\nV 1\nT 2\n", tape::HEADER)).expect("write");
     let err = tape::read(&path).expect_err("a bad line");
     assert!(err.to_string().contains("tape line 3"), "{err}");
+}
+
+/// The loop reads the bus between ticks ([`driver::daemon::READ_EVERY_US`]) so a tick's own
+/// read is short: what reached the bus is, bit for bit and at the same times, what a loop
+/// reading only at its deadlines sends; and just before each deadline at most one read's
+/// worth of frames waits, against a whole period's without the early reads.
+#[test]
+fn reading_between_ticks_changes_nothing_a_tick_sends() {
+    const END_US: u64 = 3_000_000;
+    let plan = || {
+        let mut p = FaultPlan::new();
+        p.add(
+            Fault::BadCrc {
+                target: CrcTarget::Emg,
+                every: 3,
+            },
+            1_200_000,
+            1_400_000,
+        )
+        .expect("fault");
+        p
+    };
+    let mut early = Rig::new(plan(), Script::resting(10_000_000));
+    let mut late = Rig::new(plan(), Script::resting(10_000_000));
+    // Just before each deadline: the frames that wait for the tick's read.
+    let waiting = |rig: &mut Rig, ticks_only: bool| {
+        let mut most = 0;
+        while rig.clock_now() < END_US {
+            let before = rig.runner.next_deadline_us() - 1000;
+            if ticks_only {
+                rig.run_ticks_only_until(before);
+            } else {
+                rig.run_until(before);
+            }
+            most = most.max(rig.runner.transport().pending());
+            let t = rig.clock_now() + 1000;
+            if ticks_only {
+                rig.run_ticks_only_until(t);
+            } else {
+                rig.run_until(t);
+            }
+        }
+        most
+    };
+    let early_most = waiting(&mut early, false);
+    let late_most = waiting(&mut late, true);
+    // Each start draws a fresh setpoint epoch (its CRC with it): the setpoints are compared
+    // decoded, the heartbeat and the diagnostics frame raw.
+    let others = |rig: &Rig| -> Vec<(u64, CanFrame)> {
+        rig.seen
+            .iter()
+            .filter(|(_, f)| matches!(f.raw_id(), 0x300 | 0x301))
+            .cloned()
+            .collect()
+    };
+    let (a, b) = (early.setpoints(), late.setpoints());
+    println!(
+        "early reads: {} setpoints, at most {early_most} frames waiting at a deadline; ticks \
+         only: {} setpoints, at most {late_most} waiting",
+        a.len(),
+        b.len()
+    );
+    assert!(a.len() >= 5 * 55, "only {} setpoints in 3 s", a.len());
+    assert!(
+        a.iter().any(|s| s.2 == FingerMode::Active)
+            && a.iter().any(|s| s.2 == FingerMode::SafeStop),
+        "the run shows both ACTIVE setpoints and the bad CRCs' safe stops"
+    );
+    assert_eq!(a, b, "the setpoints differ when handd reads between ticks");
+    assert_eq!(
+        others(&early),
+        others(&late),
+        "the heartbeat or the diagnostics differ when handd reads between ticks"
+    );
+    let per_ms = 3; // three EMG frames each ms, besides the statuses
+    let read_ms = (driver::daemon::READ_EVERY_US / 1000) as usize;
+    assert!(
+        early_most <= (read_ms + 2) * (per_ms + 1),
+        "{early_most} frames waited for a tick's read with early reads every {read_ms} ms"
+    );
+    assert!(
+        late_most >= 40 * per_ms,
+        "{late_most} frames waited for a tick reading at its deadline only: the rig does not \
+         show what early reads remove"
+    );
 }

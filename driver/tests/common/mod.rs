@@ -126,6 +126,23 @@ impl<T: Transport> Rig<T> {
         }
     }
 
+    /// As [`Rig::run_until`], but the daemon reads the bus only at its deadlines (the loop
+    /// before it read between ticks, [`driver::daemon::READ_EVERY_US`]).
+    pub fn run_ticks_only_until(&mut self, t_end_us: u64) {
+        let mut now = self.clock.now_us();
+        while now < t_end_us {
+            now += 1000;
+            self.clock.set_us(now);
+            self.world.step(now);
+            if now >= self.runner.next_deadline_us() {
+                self.runner.step();
+            }
+            while let Some(r) = self.probe.receive_timestamped() {
+                self.seen.push((r.time_us.unwrap_or(now), r.frame));
+            }
+        }
+    }
+
     /// Advance to `t_end_us` with the daemon stopped (SIGSTOP, a stalled board): the world runs
     /// and its frames queue up for the daemon, which runs no tick.
     pub fn stall_until(&mut self, t_end_us: u64) {
