@@ -76,6 +76,13 @@ pub fn run(a: &CalibrateArgs) -> Result<(), CliError> {
     let trials = protocol.clone().unwrap_or_default().trials().len();
     let mut out = Output::new(mode, trials);
     let mut bus = socket::SocketBus::open(&a.iface)?;
+    if let Some((got, wanted)) = bus.small_rcvbuf() {
+        out.say(&format!(
+            "warning: the kernel granted a {got}-byte receive buffer of the {wanted} asked for: \
+             set net.core.rmem_max (README, install), or a trial's check may lose frames (the \
+             session line counts them)"
+        ));
+    }
     hold_hand(a, &mut out)?;
     if !a.yes {
         confirm(&mut out)?;

@@ -29,6 +29,11 @@ impl SocketBus {
         })
     }
 
+    /// The receive buffer the kernel granted and the one asked for, when it is smaller.
+    pub fn small_rcvbuf(&self) -> Option<(usize, usize)> {
+        self.sock.small_rcvbuf()
+    }
+
     /// Frames the kernel dropped because this socket fell behind.
     pub fn kernel_drops(&self) -> u64 {
         self.sock.kernel_drops()

@@ -68,6 +68,18 @@ pub(super) fn calibrate_deploy_arm(env: &VcanEnv) -> PathBuf {
         String::from_utf8_lossy(&cal.stdout)
     );
     assert_only_the_hold(&monitor.snapshot(), t0, t1);
+    // With the receive buffer the install sets (net.core.rmem_max, as in the VM), nothing of
+    // the session is lost while calibrate checks a trial.
+    let said = String::from_utf8_lossy(&cal.stdout);
+    let drops: Option<u64> = said
+        .split_once(" dropped by the kernel")
+        .and_then(|(before, _)| before.rsplit(' ').next())
+        .and_then(|n| n.parse().ok());
+    assert_eq!(
+        drops,
+        Some(0),
+        "handctl calibrate lost frames to the kernel (or did not say): see its output above"
+    );
     let model = out.join("model.hsm");
     handctl(
         env,
