@@ -9,12 +9,8 @@
 
 mod common;
 
-use std::sync::OnceLock;
-
 use common::Rig;
 use decoder::model::Predictor;
-use decoder::session::Session;
-use driver::demo::{record_calibration, train_on_session, DemoOptions};
 use driver::engine::Command;
 use hand_dbc::messages::FingerMode;
 use hand_model::faults::{Fault, FaultPlan};
@@ -33,23 +29,8 @@ const STOP_BAR_US: u64 = 1_200_000;
 /// A velocity setpoint this small moves a finger less than 1 degree a second.
 const STILL: f64 = 0.0175;
 
-/// A model trained on a simulated calibration, once for the whole binary.
 fn model() -> Predictor {
-    static MODEL: OnceLock<Predictor> = OnceLock::new();
-    MODEL
-        .get_or_init(|| {
-            let dir = std::env::temp_dir().join(format!("handstack-output-{}", std::process::id()));
-            let opts = DemoOptions {
-                work_dir: dir.clone(),
-                ..DemoOptions::default()
-            };
-            record_calibration(&dir, opts.seed).expect("simulated calibration");
-            let session = Session::open(&dir).expect("session");
-            let m = train_on_session(&session, &opts, &mut |_| {}).expect("training");
-            std::fs::remove_dir_all(&dir).expect("clean up");
-            m.predictor()
-        })
-        .clone()
+    common::calibrated_predictor()
 }
 
 fn rig(script: Script, faults: FaultPlan, paper: bool) -> Rig {

@@ -89,6 +89,24 @@ pub enum Fault {
     /// 8-byte frames on id 0x001 (above every hand.dbc id in priority) at 1 Mbit/s worth of
     /// worst-case-stuffed frames (7,407 frames/s): on a real bus it starves everyone else.
     BusFlood,
+    /// Beyond the calibration (issue 25): the patient contracts `pct` percent of the
+    /// calibration's full effort (a stronger grip than the one recorded), every muscle alike.
+    OverEffort {
+        /// Percent of the calibrated full effort (101..=500).
+        pct: u16,
+    },
+    /// An electrode of `channel` is knocked or pops when the fault starts: a step on that
+    /// channel that decays back (see [`crate::emg::POP_UV`]).
+    ElectrodePop {
+        /// The channel (0..12).
+        channel: u8,
+    },
+    /// The electrode band slipped around the forearm by `tenths` tenths of an electrode
+    /// spacing (positive: channel c moves toward c + 1) while the fault is on.
+    ElectrodeShift {
+        /// Tenths of a spacing, -10..=10 and not 0.
+        tenths: i8,
+    },
 }
 
 /// Ids an unknown-id burst must avoid: hand.dbc's, and 0x000/0x001 (the flood's).
@@ -128,6 +146,17 @@ impl Fault {
             {
                 bad(format!("{self:?}: channel mask must be 1..=0xFFF"))
             }
+            Fault::OverEffort { pct } if !(101..=500).contains(&pct) => bad(format!(
+                "{self:?}: percent of full effort must be 101..=500"
+            )),
+            Fault::ElectrodePop { channel } if usize::from(channel) >= crate::emg::N_CHANNELS => {
+                bad(format!("{self:?}: channel must be 0..=11"))
+            }
+            Fault::ElectrodeShift { tenths } if tenths == 0 || !(-10..=10).contains(&tenths) => {
+                bad(format!(
+                    "{self:?}: shift must be -10..=10 tenths of a spacing, not 0"
+                ))
+            }
             Fault::UnknownIdBurst { id, count } => {
                 if id > 0x7FF || RESERVED_IDS.contains(&id) {
                     bad(format!("{self:?}: id must be an 11-bit id not used by hand.dbc (nor the flood's 0x001)"))
@@ -145,7 +174,8 @@ impl Fault {
     pub const SYNTAX: &'static str =
         "drop-emg[:N] repeat-emg[:N] reorder-emg[:N] counter-jump[:BY] \
 bad-crc-emg[:N] bad-crc-status[:N] bad-crc-finger:F[:N] lead-off[:MASK] saturation[:MASK] \
-amp-silence estop motor-silent:F setpoint-loss:F unknown-ids[:ID[:COUNT]] flood";
+amp-silence estop motor-silent:F setpoint-loss:F unknown-ids[:ID[:COUNT]] flood \
+over-effort[:PCT] electrode-pop[:CH] electrode-shift[:TENTHS]";
 }
 
 fn num<T: FromStr>(s: Option<&str>, default: T, what: &str) -> Result<T, SimError> {
@@ -213,6 +243,15 @@ impl FromStr for Fault {
                 count: num(b, 100, s)?,
             },
             "flood" => Fault::BusFlood,
+            "over-effort" => Fault::OverEffort {
+                pct: num(a, 250, s)?,
+            },
+            "electrode-pop" => Fault::ElectrodePop {
+                channel: num(a, 0, s)?,
+            },
+            "electrode-shift" => Fault::ElectrodeShift {
+                tenths: num(a, 5, s)?,
+            },
             _ => {
                 return Err(SimError::BadScript(format!(
                     "unknown fault {s:?}; known: {}",
@@ -339,6 +378,31 @@ mod tests {
             "a DBC id is not unknown"
         );
         assert!("warp-drive".parse::<Fault>().is_err());
+    }
+
+    #[test]
+    fn the_beyond_calibration_forms_parse_and_are_bounded() {
+        assert_eq!(
+            "over-effort".parse::<Fault>(),
+            Ok(Fault::OverEffort { pct: 250 })
+        );
+        assert_eq!(
+            "electrode-pop:7".parse::<Fault>(),
+            Ok(Fault::ElectrodePop { channel: 7 })
+        );
+        assert_eq!(
+            "electrode-shift:-5".parse::<Fault>(),
+            Ok(Fault::ElectrodeShift { tenths: -5 })
+        );
+        for bad in [
+            "over-effort:100",
+            "over-effort:501",
+            "electrode-pop:12",
+            "electrode-shift:0",
+            "electrode-shift:11",
+        ] {
+            assert!(bad.parse::<Fault>().is_err(), "{bad} was accepted");
+        }
     }
 
     #[test]

@@ -36,6 +36,28 @@ pub fn random_predictor(seed: u64) -> Predictor {
         .predictor()
 }
 
+/// A model trained on a simulated calibration (the demo's recording and training), once per
+/// test binary.
+pub fn calibrated_predictor() -> Predictor {
+    use std::sync::OnceLock;
+    static MODEL: OnceLock<Predictor> = OnceLock::new();
+    MODEL
+        .get_or_init(|| {
+            use driver::demo::{record_calibration, train_on_session, DemoOptions};
+            let dir = std::env::temp_dir().join(format!("handstack-cal-{}", std::process::id()));
+            let opts = DemoOptions {
+                work_dir: dir.clone(),
+                ..DemoOptions::default()
+            };
+            record_calibration(&dir, opts.seed).expect("simulated calibration");
+            let session = decoder::session::Session::open(&dir).expect("session");
+            let m = train_on_session(&session, &opts, &mut |_| {}).expect("training");
+            std::fs::remove_dir_all(&dir).expect("clean up");
+            m.predictor()
+        })
+        .clone()
+}
+
 /// World + daemon + probe; the daemon reaches the bus through `T` (the in-memory bus itself,
 /// or a wrapper that misbehaves on cue).
 pub struct Rig<T: Transport = MemTransport<VirtualClock>> {

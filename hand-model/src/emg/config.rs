@@ -136,7 +136,7 @@ impl AmplifierConfig {
     /// activity at `tonic` (0..1) summed in power, each at its worst case (full mains and drift
     /// gain, every source's cross-talk gain). The tests hold the measured rest RMS to this.
     pub fn rest_rms_bound_uv(&self, tonic: f64) -> f64 {
-        let m = crate::emg::mixing::crosstalk_matrix(self.crosstalk_width);
+        let m = crate::emg::mixing::crosstalk_matrix(self.crosstalk_width, 0.0);
         let max_gain2 = m
             .iter()
             .map(|row| row.iter().map(|g| g * g).sum::<f64>())

@@ -38,12 +38,13 @@ pub fn source_position(s: usize) -> f64 {
 }
 
 /// The 12 × 10 gain matrix (row = channel, column = source) for cross-talk width `width`
-/// (in electrode spacings, > 0).
-pub fn crosstalk_matrix(width: f64) -> [[f64; N_SOURCES]; N_CHANNELS] {
+/// (in electrode spacings, > 0), with the electrode band turned by `shift` spacings around
+/// the forearm (0: where it was calibrated; channel `c` then sits at `c + shift`).
+pub fn crosstalk_matrix(width: f64, shift: f64) -> [[f64; N_SOURCES]; N_CHANNELS] {
     let mut m = [[0.0; N_SOURCES]; N_CHANNELS];
     for (c, row) in m.iter_mut().enumerate() {
         for (s, g) in row.iter_mut().enumerate() {
-            let raw = (c as f64 - source_position(s)).rem_euclid(N_CHANNELS as f64);
+            let raw = (c as f64 + shift - source_position(s)).rem_euclid(N_CHANNELS as f64);
             let d = raw.min(N_CHANNELS as f64 - raw);
             *g = (-d * d / (2.0 * width * width)).exp();
         }
@@ -57,7 +58,7 @@ mod tests {
 
     #[test]
     fn nearest_channels_dominate_and_wrap_around() {
-        let m = crosstalk_matrix(1.0);
+        let m = crosstalk_matrix(1.0, 0.0);
         // Thumb flexor at 0.5: channels 0 and 1 nearest, channel 11 is 1.5 away across the wrap.
         assert!((m[0][flexor(0)] - (-0.125f64).exp()).abs() < 1e-12);
         assert!((m[1][flexor(0)] - m[0][flexor(0)]).abs() < 1e-12);
@@ -66,6 +67,20 @@ mod tests {
         assert!(m[4][extensor(4)] < 1e-6);
         for row in &m {
             assert!(row.iter().all(|g| (0.0..=1.0).contains(g)));
+        }
+    }
+
+    #[test]
+    fn a_shifted_band_sees_each_muscle_from_the_shifted_place() {
+        let m = crosstalk_matrix(1.0, 0.0);
+        let half = crosstalk_matrix(1.0, 0.5);
+        // Shifted by half a spacing, channel 0 sits over the thumb flexor (at 0.5): gain 1.
+        assert!((half[0][flexor(0)] - 1.0).abs() < 1e-12);
+        assert!(half[0][flexor(0)] > m[0][flexor(0)]);
+        // A whole spacing is the next channel's place.
+        let one = crosstalk_matrix(1.0, 1.0);
+        for s in 0..N_SOURCES {
+            assert!((one[0][s] - m[1][s]).abs() < 1e-12);
         }
     }
 }

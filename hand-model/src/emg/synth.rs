@@ -74,7 +74,24 @@ pub struct ChannelFaults {
     pub lead_off: u16,
     /// Bit `c`: channel `c` is driven into the positive rail (e.g. a large motion artefact).
     pub saturated: u16,
+    /// Beyond the calibration (issue 25): every muscle contracts this many percent of what the
+    /// calibration's full effort gave (a stronger grip than the technician recorded); `None`
+    /// or 100 is as calibrated.
+    pub effort_pct: Option<u16>,
+    /// An electrode pop or a knock on one channel: `(channel, µs since it happened)`; the
+    /// channel gets a step of [`POP_UV`] that decays with [`POP_TAU_US`].
+    pub pop: Option<(u8, u64)>,
+    /// The electrode band turned around the forearm by this many tenths of an electrode
+    /// spacing (a sleeve that slipped): every muscle is seen through the shifted geometry.
+    pub shift_tenths: i8,
 }
+
+/// An electrode pop's step, µV: 7.5 times a channel's full-effort RMS (160 counts) and below
+/// the ADC's rail, so it reaches the decoder as signal, not as a saturation flag; a knocked
+/// electrode's half-cell potential jumps like this.
+pub const POP_UV: f64 = 1_200.0 * crate::dbc::EMG_LSB_UV;
+/// How fast a pop's step decays back (the electrode's charge settling), µs.
+pub const POP_TAU_US: f64 = 80_000.0;
 
 /// The 12-channel sEMG generator. Allocation-free per sample.
 #[derive(Debug, Clone)]
@@ -82,6 +99,9 @@ pub struct EmgSynth {
     cfg: AmplifierConfig,
     sources: [MuscleSource; N_SOURCES],
     mix: [[f64; N_SOURCES]; N_CHANNELS],
+    /// The cross-talk matrix of a shifted band, and its shift (tenths of a spacing); built
+    /// when a shift starts, so a sample never computes it.
+    shifted: (i8, [[f64; N_SOURCES]; N_CHANNELS]),
     floor: [GaussianNoise; N_CHANNELS],
     offset_uv: [f64; N_CHANNELS],
     drift_w: [f64; N_CHANNELS],
@@ -112,8 +132,10 @@ impl EmgSynth {
             mains_gain[c] = consts.uniform(0.5, 1.0);
             mains_phase[c] = consts.uniform(0.0, tau);
         }
+        let mix = crosstalk_matrix(cfg.crosstalk_width, 0.0);
         Ok(Self {
-            mix: crosstalk_matrix(cfg.crosstalk_width),
+            mix,
+            shifted: (0, mix),
             cfg,
             sources,
             floor,
@@ -145,9 +167,22 @@ impl EmgSynth {
     pub fn next_uv(&mut self, act: &Activation, faults: ChannelFaults, uv: &mut [f64; N_CHANNELS]) {
         let t = self.n as f64 / self.cfg.sample_rate_hz;
         self.n += 1;
+        let effort = f64::from(faults.effort_pct.unwrap_or(100)) / 100.0;
+        if faults.shift_tenths != self.shifted.0 {
+            let by = f64::from(faults.shift_tenths) / 10.0;
+            self.shifted = (
+                faults.shift_tenths,
+                crosstalk_matrix(self.cfg.crosstalk_width, by),
+            );
+        }
+        let mix = if faults.shift_tenths == 0 {
+            &self.mix
+        } else {
+            &self.shifted.1
+        };
         let mut src = [0.0; N_SOURCES];
         for (s, (out, a)) in src.iter_mut().zip(act.0.iter()).enumerate() {
-            let amp = self.cfg.max_rms_uv * a.clamp(0.0, 1.0).powf(self.cfg.curvature);
+            let amp = effort * self.cfg.max_rms_uv * a.clamp(0.0, 1.0).powf(self.cfg.curvature);
             // Every source draws its noise even at zero amplitude, so the random streams stay
             // aligned whatever the intents: same seed, same noise, different scripts comparable.
             *out = amp * self.sources[s].next();
@@ -155,12 +190,17 @@ impl EmgSynth {
         let mains_w = std::f64::consts::TAU * self.cfg.mains.hz();
         let full_scale = f64::from(ADC_MAX) * self.cfg.lsb_uv;
         for (c, out) in uv.iter_mut().enumerate() {
-            let emg: f64 = self.mix[c].iter().zip(src.iter()).map(|(g, x)| g * x).sum();
+            let emg: f64 = mix[c].iter().zip(src.iter()).map(|(g, x)| g * x).sum();
             let mains =
                 self.cfg.mains_uv * self.mains_gain[c] * (mains_w * t + self.mains_phase[c]).sin();
             let drift = self.cfg.drift_uv * (self.drift_w[c] * t + self.drift_phase[c]).sin();
             let noise = self.cfg.noise_floor_uv * self.floor[c].next_std();
             let mut v = emg + mains + drift + noise + self.offset_uv[c];
+            if let Some((ch, age_us)) = faults.pop {
+                if usize::from(ch) == c {
+                    v += POP_UV * (-(age_us as f64) / POP_TAU_US).exp();
+                }
+            }
             let bit = 1u16 << c;
             if faults.lead_off & bit != 0 {
                 v = 4.0 * full_scale * (mains_w * t + self.mains_phase[c]).sin();
@@ -216,5 +256,83 @@ mod tests {
             s.saturated, 0b1100,
             "exactly-at-rail values are not clipping"
         );
+    }
+
+    /// RMS of channel `c` over `n` samples of `act` with `faults` (a fresh synthesiser, so
+    /// runs with different faults see the same noise).
+    fn rms(act: &Activation, faults: ChannelFaults, c: usize, n: usize) -> Vec<f64> {
+        let mut s = EmgSynth::try_new(AmplifierConfig::default()).expect("config");
+        let mut uv = [0.0; N_CHANNELS];
+        (0..n)
+            .map(|_| {
+                s.next_uv(act, faults, &mut uv);
+                uv[c]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn over_effort_scales_the_muscles_and_a_pop_decays_on_its_channel_alone() {
+        let mut act = Activation::default();
+        act.0[super::super::mixing::flexor(1)] = 1.0;
+        let base = rms(&act, ChannelFaults::default(), 1, 2000);
+        let twice = rms(
+            &act,
+            ChannelFaults {
+                effort_pct: Some(200),
+                ..ChannelFaults::default()
+            },
+            1,
+            2000,
+        );
+        let as_calibrated = rms(
+            &act,
+            ChannelFaults {
+                effort_pct: Some(100),
+                ..ChannelFaults::default()
+            },
+            1,
+            2000,
+        );
+        assert_eq!(base, as_calibrated, "100 % is the calibration, bit for bit");
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+        let ac = |v: &[f64]| {
+            let m = mean(v);
+            (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
+        };
+        let ratio = ac(&twice) / ac(&base);
+        assert!(
+            (1.9..=2.05).contains(&ratio),
+            "2x effort gave {ratio:.3}x the RMS"
+        );
+        // A pop 20 ms old on channel 3: its step, decayed, on channel 3 only.
+        let pop = ChannelFaults {
+            pop: Some((3, 20_000)),
+            ..ChannelFaults::default()
+        };
+        let quiet = Activation::default();
+        let with = rms(&quiet, pop, 3, 1);
+        let without = rms(&quiet, ChannelFaults::default(), 3, 1);
+        let step = POP_UV * (-20_000.0 / POP_TAU_US).exp();
+        assert!((with[0] - without[0] - step).abs() < 1e-9);
+        assert_eq!(
+            rms(&quiet, pop, 4, 1),
+            rms(&quiet, ChannelFaults::default(), 4, 1)
+        );
+    }
+
+    #[test]
+    fn a_shifted_band_changes_what_each_channel_sees() {
+        let mut act = Activation::default();
+        act.0[super::super::mixing::flexor(0)] = 1.0;
+        let shifted = ChannelFaults {
+            shift_tenths: 5,
+            ..ChannelFaults::default()
+        };
+        // Half a spacing on, channel 0 sits over the thumb flexor: it sees more of it.
+        let a = rms(&act, ChannelFaults::default(), 0, 2000);
+        let b = rms(&act, shifted, 0, 2000);
+        let p = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>();
+        assert!(p(&b) > 1.15 * p(&a), "{} vs {}", p(&b), p(&a));
     }
 }

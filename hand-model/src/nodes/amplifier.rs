@@ -167,10 +167,13 @@ impl AmplifierNode {
 
     fn channel_faults(&self, t: u64) -> ChannelFaults {
         let mut cf = ChannelFaults::default();
-        for (_, f) in self.faults.active(t) {
-            match f {
+        for (_, s) in self.faults.iter().filter(|(_, s)| s.active(t)) {
+            match s.fault {
                 Fault::LeadOff { channels } => cf.lead_off |= channels,
                 Fault::Saturation { channels } => cf.saturated |= channels,
+                Fault::OverEffort { pct } => cf.effort_pct = Some(pct),
+                Fault::ElectrodePop { channel } => cf.pop = Some((channel, t - s.from_us)),
+                Fault::ElectrodeShift { tenths } => cf.shift_tenths = tenths,
                 _ => {}
             }
         }
