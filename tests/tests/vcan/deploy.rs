@@ -93,6 +93,9 @@ fn heartbeat_ids(seen: &[Seen]) -> Vec<(u64, u32)> {
         .collect()
 }
 
+/// The sine scenario's length, s.
+const SIM_S: f64 = 16.0;
+
 #[test]
 fn deploy_refuses_bad_models_swaps_a_good_one_and_rolls_back() {
     let rig = Rig::start("deploy", 100);
@@ -100,7 +103,10 @@ fn deploy_refuses_bad_models_swaps_a_good_one_and_rolls_back() {
     let id_a = fingerprint(&std::fs::read(&model).expect("model"));
     let (corrupt, other, second, id_b) = model_files(&model, &rig.dir);
     assert_ne!(id_a, id_b);
-    let mut sim = rig.sim("sine", 10.0, &[]);
+    // Long enough for every step under a slow emulator (about 10.5 s of them measured; a
+    // 10 s scenario once ended inside the last span, whose amplifier silence then stopped the
+    // thumb); stopped once the checks' spans are over.
+    let mut sim = rig.sim("sine", SIM_S, &[]);
     let start = wait_scenario_start(&rig.monitor);
     std::thread::sleep(Duration::from_secs(2));
     let misses = rig.cfg.status(&rig.env).deadline_misses;
@@ -127,7 +133,13 @@ fn deploy_refuses_bad_models_swaps_a_good_one_and_rolls_back() {
     let rearmed = arm_after(&rig, 500);
     std::thread::sleep(Duration::from_millis(1500));
     let after = rig.cfg.status(&rig.env);
-    sim.wait_success(Duration::from_secs(60));
+    let ended = now_us();
+    assert!(
+        ended < start + (SIM_S * 1e6) as u64,
+        "the steps took {:.1} s of the {SIM_S} s scenario: the last span ran without it",
+        (ended - start) as f64 * 1e-6
+    );
+    sim.kill();
     let seen = rig.monitor.finish();
     let times = Times {
         from: start + 2_000_000,

@@ -31,24 +31,46 @@ const STILL_RAD: f64 = 0.002;
 /// How far the control must move it at least, rad.
 const MOVED_RAD: f64 = 0.02;
 
-/// handd's setpoints for `FINGER` as the reader gets them, until (and with) the first one that
-/// is not ACTIVE: (the last ACTIVE one, the first other one).
-fn until_last_round(reader: &CanSocket) -> (FingerSetpoint, FingerSetpoint) {
-    let begun = Instant::now();
+/// `FINGER`'s setpoint in `frame`, if it is one.
+fn finger_setpoint(frame: &socketcan::CanFrame) -> Option<FingerSetpoint> {
+    let socketcan::CanFrame::Data(d) = frame else {
+        return None;
+    };
+    let id = FingerSetpoint::IDS[FINGER];
+    (d.raw_id() == id)
+        .then(|| FingerSetpoint::decode(id, d.data()).expect("handd's setpoint decodes"))
+}
+
+/// Reads what waits on `reader` (without blocking): the last ACTIVE setpoint of `FINGER`.
+fn drain_keeping_the_last_active(reader: &CanSocket) -> Option<FingerSetpoint> {
+    reader.set_nonblocking(true).expect("nonblocking");
     let mut active = None;
+    while let Ok(f) = reader.read_frame() {
+        if let Some(sp) = finger_setpoint(&f).filter(|sp| sp.mode() == FingerMode::Active) {
+            active = Some(sp);
+        }
+    }
+    reader.set_nonblocking(false).expect("blocking");
+    active
+}
+
+/// handd's setpoints for `FINGER` as the reader gets them, until (and with) the first one that
+/// is not ACTIVE: (the last ACTIVE one, the first other one). `active` is the last ACTIVE one
+/// read before SIGTERM: the signal may land before handd's next tick, so its first setpoint
+/// after it may already be the last round.
+fn until_last_round(
+    reader: &CanSocket,
+    mut active: Option<FingerSetpoint>,
+) -> (FingerSetpoint, FingerSetpoint) {
+    let begun = Instant::now();
     loop {
         assert!(
             begun.elapsed() < Duration::from_secs(3),
             "handd sent no last round for finger {FINGER} within 3 s of SIGTERM"
         );
-        let Ok(socketcan::CanFrame::Data(d)) = reader.read_frame() else {
+        let Some(sp) = reader.read_frame().ok().as_ref().and_then(finger_setpoint) else {
             continue;
         };
-        let id = FingerSetpoint::IDS[FINGER];
-        if d.raw_id() != id {
-            continue;
-        }
-        let sp = FingerSetpoint::decode(id, d.data()).expect("handd's setpoint decodes");
         if sp.mode() == FingerMode::Active {
             active = Some(sp);
             continue;
@@ -95,15 +117,13 @@ fn stale_active_setpoint_before_the_next_epochs_safe_stop_after_sigterm_moves_no
     while now_us() < start + ONSET_US {
         std::thread::sleep(Duration::from_millis(1));
     }
-    reader.set_nonblocking(true).expect("nonblocking");
-    while reader.read_frame().is_ok() {}
-    reader.set_nonblocking(false).expect("blocking");
+    let before = drain_keeping_the_last_active(&reader);
     let term = Command::new("kill")
         .args(["-TERM", &rig.handd.pid().to_string()])
         .status()
         .expect("kill runs");
     assert!(term.success(), "kill -TERM handd failed");
-    let (running, last) = until_last_round(&reader);
+    let (running, last) = until_last_round(&reader, before);
     let here = statuses(&rig.monitor.snapshot(), start, now_us())
         .last()
         .map(|s| s.1)
