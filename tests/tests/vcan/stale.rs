@@ -41,26 +41,34 @@ fn finger_setpoint(frame: &socketcan::CanFrame) -> Option<FingerSetpoint> {
         .then(|| FingerSetpoint::decode(id, d.data()).expect("handd's setpoint decodes"))
 }
 
-/// Reads what waits on `reader` (without blocking): the last ACTIVE setpoint of `FINGER`.
-fn drain_keeping_the_last_active(reader: &CanSocket) -> Option<FingerSetpoint> {
+/// Empties `reader`'s queue (it holds the oldest frames since it was opened: the kernel drops
+/// new ones when it is full), then waits for the next ACTIVE setpoint of `FINGER`: a tick
+/// handd has just sent, so a signal sent now lands while handd runs.
+fn next_active_tick(reader: &CanSocket) -> FingerSetpoint {
     reader.set_nonblocking(true).expect("nonblocking");
-    let mut active = None;
-    while let Ok(f) = reader.read_frame() {
-        if let Some(sp) = finger_setpoint(&f).filter(|sp| sp.mode() == FingerMode::Active) {
-            active = Some(sp);
+    while reader.read_frame().is_ok() {}
+    reader.set_nonblocking(false).expect("blocking");
+    let begun = Instant::now();
+    loop {
+        assert!(
+            begun.elapsed() < Duration::from_secs(3),
+            "handd sent no ACTIVE setpoint for finger {FINGER} within 3 s: is it RUNNING?"
+        );
+        if let Some(sp) = reader.read_frame().ok().as_ref().and_then(finger_setpoint) {
+            if sp.mode() == FingerMode::Active {
+                return sp;
+            }
         }
     }
-    reader.set_nonblocking(false).expect("blocking");
-    active
 }
 
 /// handd's setpoints for `FINGER` as the reader gets them, until (and with) the first one that
-/// is not ACTIVE: (the last ACTIVE one, the first other one). `active` is the last ACTIVE one
-/// read before SIGTERM: the signal may land before handd's next tick, so its first setpoint
+/// is not ACTIVE: (the last ACTIVE one, the first other one). `active` is the ACTIVE one read
+/// just before SIGTERM: the signal may land before handd's next tick, so its first setpoint
 /// after it may already be the last round.
 fn until_last_round(
     reader: &CanSocket,
-    mut active: Option<FingerSetpoint>,
+    mut active: FingerSetpoint,
 ) -> (FingerSetpoint, FingerSetpoint) {
     let begun = Instant::now();
     loop {
@@ -72,10 +80,9 @@ fn until_last_round(
             continue;
         };
         if sp.mode() == FingerMode::Active {
-            active = Some(sp);
+            active = sp;
             continue;
         }
-        let active = active.expect("handd was RUNNING (ACTIVE setpoints) before SIGTERM");
         return (active, sp);
     }
 }
@@ -117,7 +124,7 @@ fn stale_active_setpoint_before_the_next_epochs_safe_stop_after_sigterm_moves_no
     while now_us() < start + ONSET_US {
         std::thread::sleep(Duration::from_millis(1));
     }
-    let before = drain_keeping_the_last_active(&reader);
+    let before = next_active_tick(&reader);
     let term = Command::new("kill")
         .args(["-TERM", &rig.handd.pid().to_string()])
         .status()
