@@ -122,11 +122,15 @@ fn deploy_refuses_bad_models_swaps_a_good_one_and_rolls_back() {
     // Both files record no patient: deploy asks, and a script says yes with --yes.
     let (ok, said) = handctl_any(&rig, &["deploy", &second]);
     assert!(!ok && said.contains("pass --yes"), "{said}");
+    // The swap takes effect before handctl returns (its exit is slow under emulation): the
+    // spans before a swap end when its command was sent, not after it returned.
+    let deploy_sent = now_us();
     let (ok, said) = handctl_any(&rig, &["deploy", &second, "--yes"]);
     assert!(ok && said.contains(&format!("{id_b:08x}")), "{said}");
     let deployed = now_us();
     let armed = arm_after(&rig, 500);
     std::thread::sleep(Duration::from_millis(1500));
+    let roll_sent = now_us();
     let (ok, said) = handctl_any(&rig, &["rollback"]);
     assert!(ok && said.contains(&format!("{id_a:08x}")), "{said}");
     let rolled = now_us();
@@ -143,8 +147,10 @@ fn deploy_refuses_bad_models_swaps_a_good_one_and_rolls_back() {
     let seen = rig.monitor.finish();
     let times = Times {
         from: start + 2_000_000,
+        deploy_sent,
         deployed,
         armed,
+        roll_sent,
         rolled,
         rearmed,
         to: rearmed + 1_500_000,
@@ -178,8 +184,10 @@ fn arm_after(rig: &Rig, ms: u64) -> u64 {
 /// When each step happened (µs on the kernel's time base).
 struct Times {
     from: u64,
+    deploy_sent: u64,
     deployed: u64,
     armed: u64,
+    roll_sent: u64,
     rolled: u64,
     rearmed: u64,
     to: u64,
@@ -192,7 +200,7 @@ fn check(seen: &[Seen], t: &Times, (a, b): (u32, u32)) {
     let ids = heartbeat_ids(seen);
     assert!(ids
         .iter()
-        .filter(|h| h.0 >= t.from && h.0 < t.deployed - 100_000)
+        .filter(|h| h.0 >= t.from && h.0 < t.deploy_sent)
         .all(|h| h.1 == a));
     assert!(
         ids.iter()
@@ -224,7 +232,7 @@ fn check(seen: &[Seen], t: &Times, (a, b): (u32, u32)) {
         (
             "before the deploy",
             t.from,
-            t.deployed - 100_000,
+            t.deploy_sent,
             FingerMode::Active,
         ),
         (
@@ -236,7 +244,7 @@ fn check(seen: &[Seen], t: &Times, (a, b): (u32, u32)) {
         (
             "after the arm",
             t.armed + 1_000_000,
-            t.rolled - 100_000,
+            t.roll_sent,
             FingerMode::Active,
         ),
         (
