@@ -131,33 +131,26 @@ impl<T: Transport> Rig<T> {
 
     /// Advance to `t_end_us` in 1 ms steps: the world every step, the daemon at its deadlines.
     pub fn run_until(&mut self, t_end_us: u64) {
-        let mut now = self.clock.now_us();
-        while now < t_end_us {
-            now += 1000;
-            self.clock.set_us(now);
-            self.world.step(now);
-            // As `Runner::run_realtime`: a tick at its deadline, a reopen attempt between ticks.
-            if now >= self.runner.next_deadline_us() {
-                self.runner.step();
-            } else if now >= self.runner.next_wake_us() {
-                self.runner.service_bus();
-            }
-            while let Some(r) = self.probe.receive_timestamped() {
-                self.seen.push((r.time_us.unwrap_or(now), r.frame));
-            }
-        }
+        self.advance(t_end_us, true);
     }
 
     /// As [`Rig::run_until`], but the daemon reads the bus only at its deadlines (the loop
     /// before it read between ticks, [`driver::daemon::READ_EVERY_US`]).
     pub fn run_ticks_only_until(&mut self, t_end_us: u64) {
+        self.advance(t_end_us, false);
+    }
+
+    fn advance(&mut self, t_end_us: u64, between_ticks: bool) {
         let mut now = self.clock.now_us();
         while now < t_end_us {
             now += 1000;
             self.clock.set_us(now);
             self.world.step(now);
+            // As `Runner::run_realtime`: a tick at its deadline, the bus served between ticks.
             if now >= self.runner.next_deadline_us() {
                 self.runner.step();
+            } else if between_ticks && now >= self.runner.next_wake_us() {
+                self.runner.service_bus();
             }
             while let Some(r) = self.probe.receive_timestamped() {
                 self.seen.push((r.time_us.unwrap_or(now), r.frame));
