@@ -419,10 +419,28 @@ fn required_sections_are_listed_and_an_unknown_one_is_refused() {
     let mut p = split(&bytes);
     assert_eq!(
         p.meta["required"],
-        serde_json::json!(["rest_stage", "envelope"])
+        serde_json::json!(["rest_stage", "envelope", "envelope_alone"])
     );
     let load = |b: &[u8]| TrainedModel::from_bytes(b, Some(&chain(2)));
-    assert!(load(&join(&p)).is_ok());
+    let back = load(&join(&p)).expect("loads");
+    let alone = with_stage.envelope().and_then(|e| e.alone());
+    assert!(alone.is_some_and(|a| a >= 1.0), "{alone:?}");
+    assert_eq!(back.envelope().and_then(|e| e.alone()), alone);
+    // The calibration's channel ratio changes the outputs: it must be listed, and it needs
+    // the envelope it belongs to.
+    p.meta["required"] = serde_json::json!(["rest_stage", "envelope"]);
+    let e = load(&join(&p)).unwrap_err();
+    assert!(e.to_string().contains("envelope_alone"), "{e}");
+    p.meta["required"] = serde_json::json!(["rest_stage", "envelope_alone"]);
+    let envelope = p.meta.as_object_mut().unwrap().remove("envelope").unwrap();
+    let e = load(&join(&p)).unwrap_err();
+    assert!(e.to_string().contains("without an envelope"), "{e}");
+    p.meta["envelope"] = envelope;
+    // An older file (an envelope, no ratio) loads with the alone test off.
+    p.meta.as_object_mut().unwrap().remove("envelope_alone");
+    p.meta["required"] = serde_json::json!(["rest_stage", "envelope"]);
+    let older = load(&join(&p)).expect("an envelope without the ratio loads");
+    assert_eq!(older.envelope().and_then(|e| e.alone()), None);
     // A newer writer's section this build does not know.
     p.meta["required"] = serde_json::json!(["rest_stage", "envelope", "grip_limiter"]);
     let e = load(&join(&p)).unwrap_err();

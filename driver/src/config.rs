@@ -244,14 +244,17 @@ impl Default for DeployConfig {
     }
 }
 
-/// The input plausibility check (issue 25): a window with one channel beyond anything the
-/// calibration saw while the others are not (a pressed, lifted or hit electrode, not an
-/// effort) gives rest and raises `signal_quality` for as long as it lasts.
+/// The input plausibility check (issue 25): a window with one channel standing alone (a
+/// pressed, lifted, knocked or hit electrode, not an effort) gives rest and raises
+/// `signal_quality` for as long as it lasts.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PlausibilityConfig {
-    /// A window is implausible when its most excessive channel (RMS over the calibration's
-    /// largest) is above 1 and more than `spread` times the median channel's. Lower catches
+    /// A window is implausible when its top channel (RMS over the calibration's largest) is
+    /// above `decoder::model::PLAUSIBLE_FLOOR` and more than the next channel's times the
+    /// larger of `spread` and the calibration's own ratio with its margin, or above 1 and more
+    /// than `spread` times the median channel's
+    /// (`decoder::model::Envelope::implausible`). Lower catches
     /// smaller artefacts and risks stopping a genuine uneven contraction; higher the reverse.
     /// 1.5 to 100.
     pub spread: f64,

@@ -95,10 +95,15 @@ fn envelope_line(model: &TrainedModel, d: &Decoded) -> String {
         "no outputs".into()
     };
     match model.envelope() {
-        Some(_) => format!(
+        Some(e) => format!(
             "beyond the calibration: {} windows moved back into its envelope, {} implausible \
-             (one channel beyond, the others not: output rest); {range}",
-            d.beyond, d.implausible
+             (one channel standing alone: output rest; {}); {range}",
+            d.beyond,
+            d.implausible,
+            match e.alone() {
+                Some(a) => format!("the calibration's channels reached {a:.2}x the next"),
+                None => "no channel ratio recorded: the alone test is off".into(),
+            }
         ),
         None => format!(
             "this model file has no calibration envelope (older than format 2's envelope): \

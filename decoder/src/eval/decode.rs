@@ -22,7 +22,7 @@ pub struct Decoded {
     pub reference: Option<(String, Vec<f64>)>,
     /// Windows beyond the calibration's envelope, moved back into it (issue 25).
     pub beyond: usize,
-    /// Windows with one channel beyond the calibration while the others are not: output rest.
+    /// Windows with one channel standing alone (far above the next): output rest.
     pub implausible: usize,
 }
 

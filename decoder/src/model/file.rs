@@ -23,7 +23,9 @@
 //!
 //! Versions. Version 2 lists in `required` every metadata section present that changes what
 //! the model outputs (today `rest_stage`, the dead zone at rest, `envelope`, the
-//! calibration's envelope its inputs are held inside: [`super::Envelope`], and `taught`, per
+//! calibration's envelope its inputs are held inside: [`super::Envelope`], `envelope_alone`,
+//! the calibration's largest top-over-next channel ratio its plausibility check's *alone*
+//! test is relative to, and `taught`, per
 //! finger the directions the calibration taught, an untaught one held at 0: [`super::Taught`],
 //! written only when some direction was not taught); a reader refuses a
 //! file whose `required` names a section it does not know ([`FileError::UnknownRequired`]), so
@@ -70,7 +72,7 @@ pub const FORMAT_VERSION: u32 = 2;
 /// The oldest format version this build reads.
 pub const OLDEST_VERSION: u32 = 1;
 /// The metadata sections this build knows how to apply, of those a file may mark `required`.
-pub const KNOWN_REQUIRED: &[&str] = &["rest_stage", "envelope", "taught"];
+pub const KNOWN_REQUIRED: &[&str] = &["rest_stage", "envelope", "envelope_alone", "taught"];
 /// Header length in bytes.
 pub const HEADER_LEN: usize = 24;
 /// Name of the normalizer tensor in the metadata and in errors.
@@ -109,6 +111,10 @@ struct Meta {
     /// Per input feature, the calibration's largest value (absent in older files).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     envelope: Option<Vec<f64>>,
+    /// The calibration's largest top-over-next channel ratio (absent in older files, and with
+    /// one channel): the plausibility check's *alone* test ([`super::Envelope::implausible`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    envelope_alone: Option<f64>,
     /// The directions the calibration taught, per finger (absent in older files, and when both
     /// directions of every finger were taught: the stage is then the identity).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -232,6 +238,17 @@ fn read_meta(version: u32, body: &[u8]) -> Result<(Meta, &[u8]), FileError> {
         return Err(malformed(
             "taught present but not listed in required".into(),
         ));
+    }
+    if version >= 2
+        && meta.envelope_alone.is_some()
+        && !meta.required.iter().any(|r| r == "envelope_alone")
+    {
+        return Err(malformed(
+            "envelope_alone present but not listed in required".into(),
+        ));
+    }
+    if meta.envelope_alone.is_some() && meta.envelope.is_none() {
+        return Err(malformed("envelope_alone without an envelope".into()));
     }
     if meta.rest_stage.is_some() && !meta.required.iter().any(|r| r == "rest_stage") {
         // Only a version 1 file may carry a rest stage without saying it is required.
@@ -430,11 +447,16 @@ impl TrainedModel {
             rest_rms_uv: self.rest_rms_uv.clone(),
             rest_stage: self.rest_stage,
             envelope: self.envelope.as_ref().map(|e| e.max().to_vec()),
+            envelope_alone: self.envelope.as_ref().and_then(|e| e.alone()),
             taught: (!self.taught.is_both()).then_some(self.taught),
             provenance: self.provenance.clone(),
             required: [
                 self.rest_stage.is_some().then_some("rest_stage"),
                 self.envelope.is_some().then_some("envelope"),
+                self.envelope
+                    .as_ref()
+                    .and_then(|e| e.alone())
+                    .map(|_| "envelope_alone"),
                 (!self.taught.is_both()).then_some("taught"),
             ]
             .into_iter()
@@ -494,6 +516,7 @@ impl TrainedModel {
         match meta.envelope {
             Some(max) => {
                 let envelope = super::Envelope::try_new(max)
+                    .and_then(|e| e.with_alone(meta.envelope_alone))
                     .map_err(|e| FileError::Malformed(format!("envelope: {e}")))?;
                 trained
                     .with_envelope(Some(envelope))

@@ -63,7 +63,7 @@ pub use config::{Optimizer, TrainConfig, ValidationSplit};
 pub use dataset::{Dataset, N_FINGERS};
 pub use dense::DenseNet;
 pub use effort::{ray_directions, ray_penalty, EffortPenalty, RayWork, MAX_EFFORT_POINTS};
-pub use envelope::{Envelope, PLAUSIBLE_SPREAD};
+pub use envelope::{Envelope, ALONE_MARGIN, PLAUSIBLE_FLOOR, PLAUSIBLE_SPREAD};
 pub use error::{FileError, ModelError, TrainError};
 pub use file::{FORMAT_VERSION, HEADER_LEN, MAGIC, NORMALIZER_TENSOR};
 pub use kind::ModelKind;

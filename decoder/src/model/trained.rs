@@ -334,8 +334,8 @@ impl Predictor {
         self.last_scale
     }
 
-    /// Whether the last window was implausible (one channel beyond the calibration while the
-    /// others are not: see [`Envelope::implausible`]); its output was rest.
+    /// Whether the last window was implausible (one channel standing alone, more than the
+    /// spread above the next: see [`Envelope::implausible`]); its output was rest.
     pub fn last_implausible(&self) -> bool {
         self.last_implausible
     }

@@ -452,7 +452,7 @@ impl Engine {
         if predictor.last_scale() < 1.0 {
             self.counters.beyond_calibration += 1;
         }
-        // One channel beyond the calibration while the others are not: a pressed or lifted
+        // One channel standing alone, far above the next: a pressed, lifted or knocked
         // electrode, not an effort. The predictor gave rest; the hand stops while it lasts.
         if predictor.last_implausible() {
             self.counters.implausible += 1;
