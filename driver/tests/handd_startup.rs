@@ -154,3 +154,26 @@ fn with_the_bus_down_handd_stays_up_ignores_sighup_and_stops_cleanly_on_sigterm(
     );
     std::fs::remove_dir_all(&dir).expect("clean up");
 }
+
+/// Issue 28: handd's manual page (section 8) comes from its clap definition, and `--man` reads
+/// no config.
+#[test]
+fn handd_prints_its_manual_page() {
+    let out = Command::new(env!("CARGO_BIN_EXE_handd"))
+        .args(["--man", "--config", "/nonexistent/handd.toml"])
+        .output()
+        .expect("run handd");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let page = String::from_utf8(out.stdout).expect("utf-8");
+    assert!(page.contains(".TH handd 8"), "{page}");
+    for option in ["config", "check", "rt\\-priority", "tape"] {
+        assert!(
+            page.contains(&format!("\\fB\\-\\-{option}")),
+            "--{option}: {page}"
+        );
+    }
+}

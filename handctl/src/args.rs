@@ -67,6 +67,28 @@ pub enum Command {
     /// the simulated hand while the patient tracks a sine, and score the tracking (needs a
     /// handctl built with the `sim` feature).
     Demo(DemoArgs),
+    /// Print the shell completion script for SHELL (bash, zsh, fish, elvish, powershell) to
+    /// standard output; the Debian package installs bash's, zsh's and fish's.
+    Completions(CompletionsArgs),
+    /// Write handctl's manual pages (roff, section 1: handctl.1 and handctl-SUBCOMMAND.1 for
+    /// every subcommand) into DIR (the package installs them).
+    #[command(hide = true)]
+    Man(ManArgs),
+}
+
+/// `handctl man`.
+#[derive(Debug, Args)]
+pub struct ManArgs {
+    /// Directory to write the pages into (created if missing).
+    pub dir: PathBuf,
+}
+
+/// `handctl completions`.
+#[derive(Debug, Args)]
+pub struct CompletionsArgs {
+    /// The shell.
+    #[arg(value_enum)]
+    pub shell: clap_complete::Shell,
 }
 
 /// How to reach the running daemon.

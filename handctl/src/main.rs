@@ -17,6 +17,7 @@ mod decode;
 #[cfg(feature = "sim")]
 mod demo;
 mod deploy;
+mod docs;
 mod error;
 mod eval;
 mod import;
@@ -59,6 +60,8 @@ fn main() -> ExitCode {
         Command::Replay(a) => replay::run(a),
         Command::Calibrate(a) => calibrate::run(a),
         Command::Demo(a) => run_demo(a),
+        Command::Completions(a) => docs::completions(a),
+        Command::Man(a) => docs::man(a),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -580,3 +580,60 @@ fn train_refuses_a_reversing_model_force_records_it_and_eval_scores_the_file() {
     assert_eq!(tables(&o), tables(&text(&trained.stdout)));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Issue 28: the completions and the manual pages come from the clap definitions: every
+/// subcommand is in the bash completion and has its own page, and handd prints its page.
+#[test]
+fn completions_and_manual_pages_cover_every_subcommand() {
+    let subcommands = [
+        "train",
+        "eval",
+        "import-3dc",
+        "check",
+        "verify",
+        "import",
+        "decode",
+        "status",
+        "tune",
+        "arm",
+        "stop",
+        "deploy",
+        "rollback",
+        "monitor",
+        "record",
+        "replay",
+        "calibrate",
+        "demo",
+        "completions",
+    ];
+    let out = handctl(&["completions", "bash"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let bash = text(&out.stdout);
+    for sub in subcommands {
+        assert!(bash.contains(sub), "the bash completion lacks {sub}");
+    }
+    for shell in ["zsh", "fish"] {
+        let out = handctl(&["completions", shell]);
+        assert!(out.status.success() && out.stdout.len() > 1000, "{shell}");
+    }
+    let bad = handctl(&["completions", "tcsh"]);
+    assert_eq!(
+        bad.status.code(),
+        Some(2),
+        "an unknown shell is a usage error"
+    );
+    let dir = tmp("man");
+    let out = handctl(&["man", s(&dir)]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let page = std::fs::read_to_string(dir.join("handctl.1")).expect("handctl.1");
+    assert!(page.contains(".TH handctl 1"), "{page}");
+    for sub in subcommands {
+        let page = std::fs::read_to_string(dir.join(format!("handctl-{sub}.1")))
+            .unwrap_or_else(|e| panic!("handctl-{sub}.1: {e}"));
+        assert!(
+            page.contains(&format!(".TH handctl-{sub} 1")),
+            "{sub}: {page}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -31,7 +31,7 @@ use hand_clock::{Clock, SystemClock};
 
 /// The handstack daemon.
 #[derive(Parser, Debug)]
-#[command(version, about)]
+#[command(name = "handd", version, about)]
 struct Args {
     /// Config file.
     #[arg(long, default_value = DEFAULT_CONFIG_PATH)]
@@ -53,6 +53,9 @@ struct Args {
     /// for tests and investigations, not for everyday use.
     #[arg(long, value_name = "FILE")]
     tape: Option<PathBuf>,
+    /// Print handd's manual page (roff) to standard output and exit (the package installs it).
+    #[arg(long, hide = true)]
+    man: bool,
 }
 
 /// Whether the human-readable log may carry ANSI colours: only on a terminal, never in JSON
@@ -108,6 +111,9 @@ fn init_logs(json: bool) {
 
 fn main() -> ExitCode {
     let args = Args::parse();
+    if args.man {
+        return print_man();
+    }
     init_logs(args.json_logs);
     match run(&args) {
         Ok(()) => ExitCode::SUCCESS,
@@ -116,6 +122,24 @@ fn main() -> ExitCode {
             // alike (an extra eprintln! printed it a second time on the same stderr).
             tracing::error!("refusing to start: {e}");
             ExitCode::from(2)
+        }
+    }
+}
+
+/// Prints the manual page generated from [`Args`] (clap_mangen).
+fn print_man() -> ExitCode {
+    use clap::CommandFactory;
+    use std::io::Write;
+    let mut out = Vec::new();
+    let written = clap_mangen::Man::new(Args::command())
+        .section("8")
+        .render(&mut out)
+        .and_then(|()| std::io::stdout().write_all(&out));
+    match written {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("handd: cannot write the manual page: {e}");
+            ExitCode::FAILURE
         }
     }
 }
