@@ -213,11 +213,11 @@ fn check(seen: &[Seen], t: &Times, (a, b): (u32, u32)) {
         .into_iter()
         .filter(|s| s.finger == 0 && s.time_us >= t.from && s.time_us <= t.to)
         .collect();
-    let gaps = thumb
+    let (gaps, gap_at) = thumb
         .windows(2)
-        .map(|w| w[1].time_us - w[0].time_us)
+        .map(|w| (w[1].time_us - w[0].time_us, w[0].time_us))
         .max()
-        .unwrap_or(0);
+        .unwrap_or((0, t.from));
     let modes = |from: u64, to: u64| -> Vec<FingerMode> {
         thumb
             .iter()
@@ -269,9 +269,21 @@ fn check(seen: &[Seen], t: &Times, (a, b): (u32, u32)) {
         );
         assert!(all(&m, want), "{what}: want only {want:?}, got {m:?}");
     }
+    // Where the longest gap fell among the steps (a missed tick shows as one): ms from the
+    // refusals' start (2 s into the scenario) to the gap and to each step.
+    let ms = |at: u64| (at as f64 - t.from as f64) * 1e-3;
     println!(
-        "deploy: {} thumb setpoints, longest gap {gaps} us",
-        thumb.len()
+        "deploy: {} thumb setpoints, longest gap {gaps} us, from {:.0} ms (steps, ms: deploy \
+         sent {:.0}, swapped {:.0}, armed {:.0}, rollback sent {:.0}, rolled {:.0}, re-armed \
+         {:.0})",
+        thumb.len(),
+        ms(gap_at),
+        ms(t.deploy_sent),
+        ms(t.deployed),
+        ms(t.armed),
+        ms(t.roll_sent),
+        ms(t.rolled),
+        ms(t.rearmed)
     );
     assert!(gaps < 100_000, "a gap of {gaps} us between setpoints");
 }
