@@ -12,7 +12,7 @@ use hand_model::dbc::seal;
 use handstack_tests::vcan::monitor::{now_us, writer, Seen};
 use socketcan::{CanSocket, EmbeddedFrame, Frame, Socket};
 
-use super::{wait_scenario_start, Rig, DRILL_SILENCE_MS, ONSET_US, RUN_S};
+use super::{wait_scenario_start, Rig, DRILL_SILENCE_MS, ONSET_US};
 
 /// The finger the stale setpoints are aimed at (index).
 const FINGER: usize = 1;
@@ -23,9 +23,20 @@ const FAULT_STALE_EPOCH: u8 = 1 << 6;
 /// back the frames after it, so the controller may brake by itself and retire handd's epoch
 /// too (handd then binds a new one with its safe stops).
 const STALE_INJECTIONS: usize = 5;
-/// After the stale frames, time for the controller to brake by itself (150 ms), handd to bind
-/// it to a new epoch and its stream to be trusted again, ms.
-const SETTLE_MS: u64 = 800;
+/// After the stale frames, the controller brakes by itself (150 ms), handd binds it to a new
+/// epoch and its stream is trusted again. The control waits until, for this long, handd's
+/// epoch has not changed and the finger's statuses carry no timeout, E2E or stale-epoch fault,
+/// ms (a fixed wait failed on a loaded machine).
+const QUIET_MS: u64 = 400;
+/// The longest the settling may take, ms (measured in the VM: quiet from about 190 ms after
+/// the last stale frame on, so the control goes out about 600 ms after it).
+const SETTLE_LIMIT_MS: u64 = 2500;
+/// The simulated hand's run, s: the bus-off comes at 2.5 s and the control about 1.4 s after
+/// it; the rest is margin for a loaded machine (the suite's 5 s left 0.7 s, and a control that
+/// comes after the simulator stopped cannot move a finger).
+const RUN_S: f64 = 7.0;
+/// FINGER_STATUS fault bits 3 (setpoint timeout) and 4 (setpoint E2E).
+const FAULT_TIMEOUT_OR_E2E: u8 = (1 << 3) | (1 << 4);
 /// How far the finger may drift while the stale frames come, rad (2 status LSB).
 const STILL_RAD: f64 = 0.002;
 /// How far the control injection must move it at least, rad.
@@ -54,29 +65,72 @@ fn next_handd_setpoint(reader: &CanSocket) -> FingerSetpoint {
     }
 }
 
+/// Attempts at placing one injected frame right after handd's setpoint: one that comes after
+/// handd's next setpoint instead (the test process held up for a period, as a loaded VM can)
+/// repeats handd's counter, which E2E drops before the epoch rule sees it, and is tried again.
+const ATTEMPTS: usize = 5;
+
 /// Right after handd's setpoint with counter c, an ACTIVE setpoint of `epoch` with counter
-/// c + 1 and the right CRC: E2E accepts it. Returns when it was written.
+/// c + 1 and the right CRC: E2E accepts it. Returns when it was written, once it is seen on
+/// the bus before handd's next setpoint (in sequence), after at most [`ATTEMPTS`] tries.
 fn inject_after(reader: &CanSocket, w: &CanSocket, epoch: u16, velocity: f64) -> u64 {
-    let handd = next_handd_setpoint(reader);
-    // Force of the velocity's sign: the controller moves only when the two agree (hand.dbc).
-    let sp = FingerSetpoint::new(
-        FINGER,
-        FingerMode::Active,
-        20.0_f64.copysign(velocity),
-        velocity,
-        epoch,
-    )
-    .expect("in range");
-    let mut frame = sp.to_frame();
-    seal(
-        &mut frame,
-        FingerSetpoint::E2E[FINGER],
-        (handd.counter() + 1) & 0x0F,
-        false,
+    for attempt in 1..=ATTEMPTS {
+        let handd = next_handd_setpoint(reader);
+        // Force of the velocity's sign: the controller moves only when the two agree (hand.dbc).
+        let sp = FingerSetpoint::new(
+            FINGER,
+            FingerMode::Active,
+            20.0_f64.copysign(velocity),
+            velocity,
+            epoch,
+        )
+        .expect("in range");
+        let mut frame = sp.to_frame();
+        seal(
+            &mut frame,
+            FingerSetpoint::E2E[FINGER],
+            (handd.counter() + 1) & 0x0F,
+            false,
+        );
+        let out = socketcan::CanFrame::new(frame.id(), frame.data()).expect("a data frame");
+        w.write_frame(&out).expect("vcan takes the injected frame");
+        let at = now_us();
+        if came_first(reader, out.data()) {
+            return at;
+        }
+        println!(
+            "epoch: injection {attempt}/{ATTEMPTS} reached the bus after handd's next setpoint              (its counter repeats handd's, E2E drops it): trying again"
+        );
+    }
+    panic!(
+        "{ATTEMPTS} injections in a row reached the bus after handd's next setpoint: the test          process is held up for whole 50 ms periods"
     );
-    let out = socketcan::CanFrame::new(frame.id(), frame.data()).expect("a data frame");
-    w.write_frame(&out).expect("vcan takes the injected frame");
-    now_us()
+}
+
+/// Reads on until the injected frame (`data`) or handd's next setpoint for `FINGER` comes:
+/// true when the injected one came first, so its counter is next in sequence.
+fn came_first(reader: &CanSocket, data: &[u8]) -> bool {
+    let begun = Instant::now();
+    loop {
+        assert!(
+            begun.elapsed() < Duration::from_secs(2),
+            "neither the injected frame nor handd's next setpoint within 2 s"
+        );
+        let Ok(socketcan::CanFrame::Data(d)) = reader.read_frame() else {
+            continue;
+        };
+        let id = FingerSetpoint::IDS[FINGER];
+        if d.raw_id() != id {
+            continue;
+        }
+        if d.data() == data {
+            return true;
+        }
+        let sp = FingerSetpoint::decode(id, d.data()).expect("a setpoint decodes");
+        if sp.mode() != FingerMode::Active {
+            return false;
+        }
+    }
 }
 
 /// FINGER_STATUS of `FINGER` in [from, to): (time, position, state, faults).
@@ -108,6 +162,7 @@ fn epoch_before(seen: &[Seen], t: u64) -> u16 {
 
 /// What the test did and when (µs on the kernel's time base).
 struct Injected {
+    start: u64,
     onset: u64,
     old: u16,
     current: u16,
@@ -147,13 +202,19 @@ fn bus_off_then_inject(rig: &Rig, reader: &CanSocket, w: &CanSocket) -> Injected
         next_handd_setpoint(reader);
         inject_after(reader, w, old, velocity);
     }
-    std::thread::sleep(Duration::from_millis(SETTLE_MS));
+    let stale_end = now_us();
+    let settled = wait_settled(rig, stale_end);
+    println!(
+        "epoch: handd's stream was trusted again {} ms after the last stale frame",
+        (settled - stale_end) / 1000
+    );
     reader.set_nonblocking(true).expect("nonblocking");
     while reader.read_frame().is_ok() {}
     reader.set_nonblocking(false).expect("blocking");
     let current = next_handd_setpoint(reader).epoch();
     let control_at = inject_after(reader, w, current, velocity);
     Injected {
+        start,
         onset,
         old,
         current,
@@ -161,6 +222,45 @@ fn bus_off_then_inject(rig: &Rig, reader: &CanSocket, w: &CanSocket) -> Injected
         velocity,
         stale_from,
         control_at,
+    }
+}
+
+/// Waits until handd's epoch for `FINGER` and the finger's faults have been quiet for
+/// [`QUIET_MS`] since `from`; returns when they became quiet.
+fn wait_settled(rig: &Rig, from: u64) -> u64 {
+    loop {
+        std::thread::sleep(Duration::from_millis(50));
+        let now = now_us();
+        assert!(
+            now < from + SETTLE_LIMIT_MS * 1000,
+            "handd's stream for finger {FINGER} did not settle within {SETTLE_LIMIT_MS} ms of \
+             the stale frames (its epoch kept changing or the finger kept reporting faults)"
+        );
+        let seen = rig.monitor.snapshot();
+        let faulted = statuses(&seen, from, now)
+            .iter()
+            .filter(|s| s.3 & (FAULT_TIMEOUT_OR_E2E | FAULT_STALE_EPOCH) != 0)
+            .map(|s| s.0)
+            .max();
+        let epochs: Vec<(u64, u16)> = seen
+            .iter()
+            .filter(|s| (from..now).contains(&s.time_us))
+            .filter_map(|s| {
+                let f = s.frame.as_ref()?;
+                (f.raw_id() == FingerSetpoint::IDS[FINGER]).then_some(())?;
+                let sp = FingerSetpoint::decode(f.raw_id(), f.data()).ok()?;
+                (sp.mode() != FingerMode::Active).then_some((s.time_us, sp.epoch()))
+            })
+            .collect();
+        let changed = epochs
+            .windows(2)
+            .filter(|p| p[0].1 != p[1].1)
+            .map(|p| p[1].0)
+            .max();
+        let quiet_since = faulted.max(changed).unwrap_or(from).max(from);
+        if !epochs.is_empty() && now >= quiet_since + QUIET_MS * 1000 {
+            return quiet_since;
+        }
     }
 }
 
@@ -224,6 +324,12 @@ fn check_control_moved(seen: &[Seen], i: &Injected) {
     let before = statuses(seen, i.stale_from, i.control_at)
         .last()
         .map_or(i.here, |s| s.1);
+    let end = i.start + (RUN_S * 1e6) as u64;
+    assert!(
+        i.control_at + 300_000 <= end,
+        "the control came {} ms after the bus-off, too late in the simulator's {RUN_S} s run",
+        (i.control_at - i.onset) / 1000
+    );
     let after = statuses(seen, i.control_at, i.control_at + 150_000);
     let moved = after
         .iter()
