@@ -177,6 +177,14 @@ pub struct ModelStatus {
     /// (and any quality gates bypassed), or "unknown patient (...)"; empty from an older daemon.
     #[serde(default, skip_serializing_if = "String::is_empty")]
     pub provenance: String,
+    /// Its guard beyond the calibration, one line (`decoder::model::Envelope::describe`);
+    /// empty from an older daemon.
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub guard: String,
+    /// True when the file lacks a guard a model trained today has (no envelope, or the alone
+    /// test off): retrain it.
+    #[serde(default)]
+    pub unguarded: bool,
 }
 
 /// The daemon's answer.

@@ -132,6 +132,7 @@ impl LoadedModel {
     /// What `handctl status` shows of this model, loaded from `path`.
     pub fn status(&self, path: &Path) -> crate::protocol::ModelStatus {
         let v = self.model.verification();
+        let (guard, unguarded) = decoder::model::Envelope::describe(self.model.envelope());
         crate::protocol::ModelStatus {
             path: path.display().to_string(),
             id: format!("{:08x}", self.model_id),
@@ -140,6 +141,8 @@ impl LoadedModel {
             unverified: !v.is_some_and(|r| r.passed()),
             patient: self.model.provenance().and_then(|p| p.patient.clone()),
             provenance: decoder::model::provenance::describe_provenance(self.model.provenance()),
+            guard,
+            unguarded,
         }
     }
 

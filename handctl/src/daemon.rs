@@ -49,7 +49,7 @@ pub(crate) fn done(reply: Reply) -> Result<Option<Status>, CliError> {
 fn format_model(s: &Status) -> String {
     match &s.model {
         Some(m) => format!(
-            "model {} ({}, id {})\n{}{}\n{}\n",
+            "model {} ({}, id {})\n{}{}\n{}\n{}{}\n",
             m.path,
             m.kind,
             m.id,
@@ -59,6 +59,12 @@ fn format_model(s: &Status) -> String {
                 "unknown patient (this handd does not report provenance)"
             } else {
                 &m.provenance
+            },
+            if m.unguarded { "!! " } else { "" },
+            if m.guard.is_empty() {
+                "beyond the calibration: not reported by this handd"
+            } else {
+                &m.guard
             }
         ),
         None => "model: not reported by this handd\n".into(),
@@ -198,6 +204,10 @@ mod tests {
             unverified,
             patient: Some("P-017".into()),
             provenance: "patient P-017, session fitting-1, calibrated 2026-12-02T13:15:28Z".into(),
+            guard: "beyond the calibration: bounded by its envelope; a channel standing alone \
+                    is implausible (the calibration's reached 2.36x the next)"
+                .into(),
+            unguarded: false,
         };
         let mut s = Status {
             model: Some(model(
@@ -211,9 +221,26 @@ mod tests {
             text.starts_with(
                 "model /var/lib/handstack/model.hsm (resdd, id 0badf00d)\n\
                  verified: 0 of 3375 rays reverse beyond 0.01 (exact)\n\
-                 patient P-017, session fitting-1, calibrated 2026-12-02T13:15:28Z\n"
+                 patient P-017, session fitting-1, calibrated 2026-12-02T13:15:28Z\n\
+                 beyond the calibration: bounded by its envelope; a channel standing alone is \
+                 implausible (the calibration's reached 2.36x the next)\n"
             ),
             "{text}"
+        );
+        // A model file from before the alone test: flagged, as an unverified one is.
+        let (guard, unguarded) = decoder::model::Envelope::describe(None);
+        s.model = Some(ModelStatus {
+            guard,
+            unguarded,
+            ..model(
+                "verified: 0 of 3375 rays reverse beyond 0.01 (exact)",
+                false,
+            )
+        });
+        assert!(
+            format_status(&s).contains("\n!! beyond the calibration: NOT bounded"),
+            "{}",
+            format_status(&s)
         );
         s.model = Some(model("FORCED: 12 of 3375 rays reverse beyond 0.01", true));
         assert!(format_status(&s).contains("\n!! FORCED: 12 of 3375"));

@@ -206,6 +206,41 @@ impl Envelope {
         self.alone
     }
 
+    /// The guard beyond the calibration, one line for a technician (`handctl status`): for
+    /// `None`, a model file without an envelope. The flag is true when a guard is missing that
+    /// a model trained today has (the envelope, or the alone test on two or more channels).
+    pub fn describe(envelope: Option<&Self>) -> (String, bool) {
+        match envelope {
+            None => (
+                "beyond the calibration: NOT bounded (the file has no calibration envelope: \
+                 an older model; retrain it to get the guard)"
+                    .into(),
+                true,
+            ),
+            Some(e) if e.channels() < 2 => (
+                "beyond the calibration: bounded by its envelope (one channel: no alone test)"
+                    .into(),
+                false,
+            ),
+            Some(e) => match e.alone {
+                Some(a) => (
+                    format!(
+                        "beyond the calibration: bounded by its envelope; a channel standing \
+                         alone is implausible (the calibration's reached {a:.2}x the next)"
+                    ),
+                    false,
+                ),
+                None => (
+                    "beyond the calibration: bounded by its envelope; the alone test is OFF \
+                     (the file records no channel ratio: an older model, so a knocked electrode \
+                     at rest is not caught; retrain it to get the test)"
+                        .into(),
+                    true,
+                ),
+            },
+        }
+    }
+
     /// Channels the envelope covers.
     fn channels(&self) -> usize {
         self.max.len() / FEATURES_PER_CHANNEL
@@ -341,6 +376,19 @@ mod tests {
     /// Two channels: every feature's maximum 1, VAR's 1 too.
     fn unit(channels: usize) -> Envelope {
         Envelope::try_new(vec![1.0; FEATURES_PER_CHANNEL * channels]).expect("envelope")
+    }
+
+    #[test]
+    fn describe_flags_a_file_without_a_guard_of_todays_models() {
+        let (text, flagged) = Envelope::describe(None);
+        assert!(flagged && text.contains("NOT bounded"), "{text}");
+        let (text, flagged) = Envelope::describe(Some(&unit(12)));
+        assert!(flagged && text.contains("alone test is OFF"), "{text}");
+        let on = unit(12).with_alone(Some(2.36)).expect("ratio");
+        let (text, flagged) = Envelope::describe(Some(&on));
+        assert!(!flagged && text.contains("2.36x the next"), "{text}");
+        let (text, flagged) = Envelope::describe(Some(&unit(1)));
+        assert!(!flagged && text.contains("one channel"), "{text}");
     }
 
     #[test]
