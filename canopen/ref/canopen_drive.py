@@ -153,7 +153,8 @@ class Drive:
         self.net.send_periodic = lambda *a, **k: NoTask()
         self.net.add_node(self.node)
         self.net.subscribe(0, self.on_nmt)
-        self.net.subscribe(0x80, self.on_sync)
+        self.sync_cob = 0x80
+        self.net.subscribe(self.sync_cob, self.on_sync)
         self.node.add_write_callback(self.on_write)
         self.cw = 0
         self.quick_stops = 0
@@ -176,7 +177,14 @@ class Drive:
         self.node.data_store.setdefault(0x6041, {})[0] = struct.pack("<H", State402.SW_MASK[state][1])
 
     def on_write(self, index, subindex, od, data):
-        if index == 0x6040:
+        if index == 0x1005:
+            # The SYNC COB-ID (CiA 301): SYNC is taken on the id written here from now on.
+            cob = struct.unpack("<I", data)[0] & 0x7FF
+            if cob != self.sync_cob:
+                self.net.unsubscribe(self.sync_cob, self.on_sync)
+                self.sync_cob = cob
+                self.net.subscribe(cob, self.on_sync)
+        elif index == 0x6040:
             prev, self.cw = self.cw, struct.unpack("<H", data)[0]
             for (frm, to), code in State402.TRANSITIONTABLE.items():
                 if frm != self.state or frm in INTERNAL or code != self.cw:

@@ -27,6 +27,8 @@ use serde_json::{json, Value};
 
 const DRIVE: u8 = 3;
 const MASTER: u8 = 100;
+/// The SYNC COB-ID the start-up writes to 0x1005 (not 0x080: hand.dbc's HAND_ESTOP).
+const SYNC_COB: u16 = 0x07F;
 
 fn python() -> PathBuf {
     if let Some(p) = std::env::var_os("HANDSTACK_PYTHON") {
@@ -278,6 +280,8 @@ fn master_core_against_python_canopen() {
         master: node(MASTER),
         mode,
         sync_period_us: 10_000,
+        // Not 0x080 (hand.dbc's HAND_ESTOP): canopen's drive must take SYNC where 0x1005 says.
+        sync_cob_id: hand_canopen::CobId::try_new(SYNC_COB).expect("11 bits"),
         master_heartbeat_timeout_ms: 100,
         drive_heartbeat_ms: 20,
         abort_connection: ABORT_CONNECTION_QUICK_STOP,
@@ -313,7 +317,11 @@ fn master_core_against_python_canopen() {
     let target: i16 = 250;
     let f = rpdo.encode(&[0x000F, target as u16 as u32]).expect("RPDO1");
     m.deliver(&mut py, vec![f]);
-    m.sync = Some(SyncProducer::try_new(10_000).expect("period"));
+    m.sync = Some(
+        SyncProducer::try_new(10_000)
+            .expect("period")
+            .on_cob_id(hand_canopen::CobId::try_new(SYNC_COB).expect("11 bits")),
+    );
     let heard = py.heard.len();
     m.step(&mut py);
     let tpdo = py.heard[heard..]

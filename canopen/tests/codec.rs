@@ -442,6 +442,12 @@ fn sync_and_heartbeat_follow_the_callers_clock() {
     // A late loop sends one SYNC, not a burst.
     assert!(s.poll(100_000).is_some());
     assert!(s.poll(100_001).is_none());
+    let on = CobId::try_new(0x07F).expect("11 bits");
+    let mut s = SyncProducer::try_new(10_000).expect("period").on_cob_id(on);
+    assert_eq!(
+        s.poll(5).map(|f| (f.cob_id(), f.payload().len())),
+        Some((0x07F, 0))
+    );
 
     let mut p = HeartbeatProducer::new(node(100), 50_000);
     assert_eq!(
@@ -491,6 +497,7 @@ fn startup_settings_are_checked_once() {
         master: node(100),
         mode: Mode::CyclicSyncTorque,
         sync_period_us: 50_000,
+        sync_cob_id: CobId::try_new(0x07F).expect("11 bits"),
         master_heartbeat_timeout_ms: 150,
         drive_heartbeat_ms: 50,
         abort_connection: 3,
@@ -509,6 +516,17 @@ fn startup_settings_are_checked_once() {
         ..s
     };
     assert_eq!(same.plan(), Err(SettingsError::SameNode(3)));
+    // 0x1005 is the first object written; NMT's id or one of the drive's own is refused.
+    assert!(steps.iter().any(|st| matches!(st,
+        hand_canopen::startup::Step::Write(w) if w.addr == ObjectAddr::new(0x1005, 0)
+            && w.data == SdoData::u32(0x07F))));
+    for bad in [0x000, 0x083, 0x703] {
+        let s = StartupSettings {
+            sync_cob_id: CobId::try_new(bad).expect("11 bits"),
+            ..s
+        };
+        assert_eq!(s.plan(), Err(SettingsError::SyncCobId(bad)));
+    }
     let short = StartupSettings {
         master_heartbeat_timeout_ms: 50,
         ..s

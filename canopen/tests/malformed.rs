@@ -63,6 +63,7 @@ fn settings() -> StartupSettings {
         master: node(100),
         mode: Mode::CyclicSyncTorque,
         sync_period_us: 10_000,
+        sync_cob_id: hand_canopen::CobId::try_new(0x07F).expect("11 bits"),
         master_heartbeat_timeout_ms: 100,
         drive_heartbeat_ms: 20,
         abort_connection: 3,

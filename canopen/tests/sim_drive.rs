@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{node, settings, Bench, DRIVE, MASTER};
+use common::{node, settings, sync_cob, Bench, DRIVE, MASTER, SYNC_COB};
 use hand_canopen::emcy::{Emcy, ErrorClass};
 use hand_canopen::pdo::{finger_pdos, Direction};
 use hand_canopen::sdo::{SdoClient, SdoError};
@@ -89,7 +89,23 @@ fn setpoint_rpdo_and_sync_give_the_tpdo() {
         .find(|p| p.direction == Direction::Tx && p.number == 1)
         .expect("TPDO1");
     let target: i16 = -321;
-    b.sync = Some(SyncProducer::try_new(10_000).expect("period > 0"));
+    // A SYNC on CiA 301's default id is not this drive's any more (the start-up wrote 0x1005):
+    // no TPDO answers it; a HAND_ESTOP-shaped frame there neither.
+    let first = b.from_drive.len();
+    b.send(hand_canopen::sync::sync_frame());
+    b.send(hand_canopen::CanFrame::new(0x080, &[0x12, 0x31, 0x00]).expect("frame"));
+    assert!(
+        b.from_drive[first..]
+            .iter()
+            .all(|(_, f)| f.cob_id() != tpdo1.cob_id.raw()),
+        "a TPDO answered a SYNC on 0x080 after 0x1005 = {SYNC_COB:#05x}"
+    );
+    assert_eq!(b.drive.sync_cob_id().raw(), SYNC_COB);
+    b.sync = Some(
+        SyncProducer::try_new(10_000)
+            .expect("period > 0")
+            .on_cob_id(sync_cob()),
+    );
     let first = b.from_drive.len();
     b.send(
         rpdo.encode(&[0x000F, target as u16 as u32])

@@ -6,11 +6,11 @@ use super::od::{ObjectDictionary, FINGER_DRIVE_OBJECTS};
 use crate::cia402::{objects, transition_for, Controlword, PowerState, Statusword};
 use crate::emcy::Emcy;
 use crate::frame::CanFrame;
-use crate::ids::{NodeId, ObjectAddr};
+use crate::ids::{CobId, NodeId, ObjectAddr};
 use crate::nmt::{ErrorControl, NmtCommand, NmtMessage, NmtState};
 use crate::pdo::{Mapped, PDO_INVALID};
 use crate::sdo::{AbortCode, SdoReply, SdoRequest};
-use crate::sync::is_sync;
+use crate::sync::is_sync_on;
 
 /// EMCY code for a lost heartbeat (CiA 301).
 pub const EMCY_HEARTBEAT: u16 = 0x8130;
@@ -50,11 +50,22 @@ pub struct SimDrive {
     stats: SimStats,
 }
 
+/// The SYNC COB-ID in 0x1005 (bits 0..10; CiA 301's bit 30 "generates SYNC" is not this
+/// node's business).
+fn sync_cob_of(raw: u32) -> CobId {
+    CobId::try_new((raw & 0x7FF) as u16).unwrap_or(CobId::SYNC)
+}
+
 fn addr(index: u16, sub: u8) -> ObjectAddr {
     ObjectAddr::new(index, sub)
 }
 
 impl SimDrive {
+    /// The COB-ID it takes SYNC on (its 0x1005).
+    pub fn sync_cob_id(&self) -> CobId {
+        sync_cob_of(self.od.get(addr(0x1005, 0)))
+    }
+
     /// A powered-off drive with the finger drive's dictionary.
     pub fn new(node: NodeId) -> Self {
         Self {
@@ -189,7 +200,7 @@ impl SimDrive {
                     self.on_nmt(m.command, now_us, out);
                 }
             }
-        } else if is_sync(f) {
+        } else if is_sync_on(f, self.sync_cob_id()) {
             if nmt == NmtState::Operational {
                 self.on_sync(out);
             }

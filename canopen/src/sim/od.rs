@@ -75,6 +75,7 @@ pub const SIM_SUPPORTED_MODES: u32 = (1 << 2) | (1 << 8) | (1 << 9);
 pub const FINGER_DRIVE_OBJECTS: &[ObjectDef] = &[
     d(0x1000, 0, 4, false, Ro, false, 0x0002_0192),
     d(0x1001, 0, 1, false, Ro, false, 0),
+    d(0x1005, 0, 4, false, Rw, false, 0x80),
     d(0x1016, 0, 1, false, Const, false, 1),
     d(0x1016, 1, 4, false, Rw, false, 0),
     d(0x1017, 0, 2, false, Rw, false, 0),

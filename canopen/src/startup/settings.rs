@@ -2,7 +2,7 @@
 
 use super::step::Step;
 use crate::cia402::{objects, Mode};
-use crate::ids::{NodeId, ObjectAddr};
+use crate::ids::{CobId, NodeId, ObjectAddr};
 use crate::pdo::finger_pdos;
 use crate::sdo::{SdoData, SdoWrite};
 use thiserror::Error;
@@ -23,6 +23,8 @@ pub struct StartupSettings {
     pub mode: Mode,
     /// The SYNC period, written to 0x60C2.
     pub sync_period_us: u32,
+    /// The SYNC COB-ID, written to 0x1005 (CiA 301's default is [`CobId::SYNC`], 0x080).
+    pub sync_cob_id: CobId,
     /// How long the drive tolerates silence from handd's heartbeat (0x1016:01), ms.
     pub master_heartbeat_timeout_ms: u16,
     /// The drive's own heartbeat period (0x1017), ms.
@@ -43,6 +45,9 @@ pub enum SettingsError {
     /// The drive and handd share a node id.
     #[error("drive node id {0} is handd's own node id")]
     SameNode(u8),
+    /// The SYNC COB-ID is NMT's or one of the drive's own COB-IDs.
+    #[error("SYNC COB-ID {0:#05x} is NMT's or one of the drive's own COB-IDs")]
+    SyncCobId(u16),
     /// 0x60C2 cannot express the SYNC period (value 1..=255 times 10^-3..10^-6 s).
     #[error("SYNC period of {0} us cannot be written to 0x60C2")]
     SyncPeriod(u32),
@@ -89,6 +94,9 @@ impl StartupSettings {
                 return Err(SettingsError::Zero(name));
             }
         }
+        if self.sync_cob_id == CobId::NMT || CobId::all_of(self.node).contains(&self.sync_cob_id) {
+            return Err(SettingsError::SyncCobId(self.sync_cob_id.raw()));
+        }
         let (ip_value, ip_index) = interpolation_period(self.sync_period_us)
             .ok_or(SettingsError::SyncPeriod(self.sync_period_us))?;
         if u64::from(self.master_heartbeat_timeout_ms) * 1000 <= u64::from(self.sync_period_us) {
@@ -101,6 +109,7 @@ impl StartupSettings {
         let consumer =
             (u32::from(self.master.get()) << 16) | u32::from(self.master_heartbeat_timeout_ms);
         let mut config = vec![
+            w(0x1005, 0, SdoData::u32(u32::from(self.sync_cob_id.raw()))),
             w(0x1017, 0, SdoData::u16(self.drive_heartbeat_ms)),
             w(0x1016, 1, SdoData::u32(consumer)),
             w(

@@ -5,10 +5,17 @@
 use hand_canopen::heartbeat::HeartbeatProducer;
 use hand_canopen::sim::SimDrive;
 use hand_canopen::startup::{Startup, StartupSettings, QUICK_STOP_RAMP_THEN_DISABLE};
-use hand_canopen::{CanFrame, Mode, NmtState, NodeId, SyncProducer};
+use hand_canopen::{CanFrame, CobId, Mode, NmtState, NodeId, SyncProducer};
 
 pub const MASTER: u8 = 100;
 pub const DRIVE: u8 = 3;
+/// The SYNC COB-ID the tests' start-up writes to 0x1005: not CiA 301's 0x080, which hand.dbc
+/// gives HAND_ESTOP.
+pub const SYNC_COB: u16 = 0x07F;
+
+pub fn sync_cob() -> CobId {
+    CobId::try_new(SYNC_COB).expect("11 bits")
+}
 
 pub fn node(id: u8) -> NodeId {
     NodeId::try_new(id).expect("test node id in range")
@@ -20,6 +27,7 @@ pub fn settings(mode: Mode) -> StartupSettings {
         master: node(MASTER),
         mode,
         sync_period_us: 10_000,
+        sync_cob_id: sync_cob(),
         master_heartbeat_timeout_ms: 100,
         drive_heartbeat_ms: 20,
         abort_connection: hand_canopen::startup::ABORT_CONNECTION_QUICK_STOP,
