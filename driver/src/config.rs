@@ -12,6 +12,7 @@ use decoder::fsio::write_atomic;
 use serde::{Deserialize, Serialize};
 
 use crate::conditioner::FingerGains;
+use crate::drive_config::{validate_drives, CanopenConfig, DriveConfig, Drives};
 use crate::units::{FINGER_NAMES, N_FINGERS};
 
 /// The default location of the config file.
@@ -104,6 +105,9 @@ pub struct FingerConfig {
     pub rest_damping: f64,
     /// Seconds a gain takes to ramp across its whole range (a live tune, every start from rest).
     pub ramp_s: f64,
+    /// How its setpoints reach the motor: hand.dbc's (default) or a CiA 402 drive's.
+    #[serde(skip_serializing_if = "DriveConfig::is_default")]
+    pub drive: DriveConfig,
 }
 
 impl Default for FingerConfig {
@@ -118,6 +122,7 @@ impl Default for FingerConfig {
             damping: g.damping_per_s,
             rest_damping: g.rest_damping_per_s,
             ramp_s: g.ramp_s,
+            drive: DriveConfig::default(),
         }
     }
 }
@@ -295,6 +300,13 @@ pub struct Config {
     pub plausibility: PlausibilityConfig,
     /// Where handd keeps what must survive a restart (its latches: see `driver::persist`).
     pub state_dir: PathBuf,
+    /// handd as a CANopen master, for fingers with a `cia402` drive.
+    #[serde(skip_serializing_if = "is_default_canopen")]
+    pub canopen: CanopenConfig,
+}
+
+fn is_default_canopen(c: &CanopenConfig) -> bool {
+    *c == CanopenConfig::default()
 }
 
 impl Default for Config {
@@ -311,6 +323,7 @@ impl Default for Config {
             deploy: DeployConfig::default(),
             plausibility: PlausibilityConfig::default(),
             state_dir: PathBuf::from("/var/lib/handstack"),
+            canopen: CanopenConfig::default(),
         }
     }
 }
@@ -451,6 +464,7 @@ impl Config {
                 allowed: "a filesystem path for the Unix socket".into(),
             });
         }
+        self.drives()?;
         if !self.state_dir.is_absolute() {
             return Err(ConfigError::Invalid {
                 field: "state_dir".into(),
@@ -459,6 +473,12 @@ impl Config {
             });
         }
         Ok(())
+    }
+
+    /// Every finger's drive, checked against the others, handd's node and hand.dbc
+    /// ([`crate::drive_config`]).
+    pub fn drives(&self) -> Result<Drives, ConfigError> {
+        validate_drives(&self.fingers, &self.canopen)
     }
 
     /// Parse and validate TOML text; `path` only names the source in errors.

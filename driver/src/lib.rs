@@ -14,6 +14,7 @@ pub mod daemon;
 #[cfg(feature = "sim")]
 pub mod demo;
 pub mod deploy;
+pub mod drive_config;
 pub mod engine;
 pub mod live;
 #[cfg(feature = "sim")]

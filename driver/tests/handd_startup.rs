@@ -177,3 +177,38 @@ fn handd_prints_its_manual_page() {
         );
     }
 }
+
+/// Issue 26, item 1: a valid `cia402` drive table passes the config's checks, and this handd,
+/// whose loop drives native fingers only, refuses it by name (also under `--check`, which
+/// gates a package upgrade) instead of running a CANopen drive as a native one. A bad one is
+/// refused naming the field.
+#[test]
+fn a_cia402_drive_is_refused_by_name_until_the_loop_drives_it() {
+    let dir = std::env::temp_dir().join(format!("handd-startup-cia402-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch directory");
+    let table = "[fingers.index.drive]\nprofile = \"cia402\"\nmode = \"cst\"\n\
+                 rated_torque_mnm = 25.0\ngear_ratio = 64.0\nmoment_arm_m = 0.04\n\
+                 max_torque_permille = 1000\nmax_speed_rpm = 8000\n";
+    for (node, says) in [
+        (
+            5,
+            "fingers.index.drive: profile = \"cia402\" is valid here, but this handd drives \
+             native (hand.dbc) fingers only",
+        ),
+        (2, "fingers.index.drive.node_id = 2 is not allowed"),
+    ] {
+        let path = dir.join(format!("node{node}.toml"));
+        std::fs::write(&path, format!("{table}node_id = {node}\n")).expect("write the config");
+        let out = Command::new(env!("CARGO_BIN_EXE_handd"))
+            .arg("--check")
+            .arg("--config")
+            .arg(&path)
+            .env_remove("RUST_LOG")
+            .output()
+            .expect("handd runs");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "node {node}: {stderr}");
+        assert!(stderr.contains(says), "node {node}: {stderr}");
+    }
+    std::fs::remove_dir_all(&dir).expect("clean up");
+}

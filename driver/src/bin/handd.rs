@@ -194,8 +194,32 @@ fn build_engine(
     (engine, chain)
 }
 
+/// A `cia402` drive passes the config's checks (`driver::drive_config`), but this handd's loop
+/// drives hand.dbc's native fingers only: the CiA 402 master core (`hand-canopen`) is not wired
+/// into it yet (issue 26). handd and `handd --check` refuse such a config, naming the fingers,
+/// rather than run a CANopen drive as if it were native.
+fn refuse_unwired_drives(config: &Config) -> Result<(), String> {
+    let drives = config.drives().map_err(|e| e.to_string())?;
+    let cia402: Vec<&str> = driver::units::FINGER_NAMES
+        .iter()
+        .zip(drives.fingers)
+        .filter(|(_, d)| matches!(d, driver::drive_config::Drive::Cia402 { .. }))
+        .map(|(n, _)| *n)
+        .collect();
+    if cia402.is_empty() {
+        return Ok(());
+    }
+    Err(format!(
+        "fingers.{}.drive: profile = \"cia402\" is valid here, but this handd drives native \
+         (hand.dbc) fingers only: the CiA 402 master is not yet wired into the control loop \
+         (issue 26); set profile = \"native\" or remove the drive table",
+        cia402.join(", fingers.")
+    ))
+}
+
 fn run(args: &Args) -> Result<(), String> {
     let config = Config::load(&args.config).map_err(|e| e.to_string())?;
+    refuse_unwired_drives(&config)?;
     let loaded = load_configured(&config, args.check)?;
     tracing::info!(config = %args.config.display(), interface = %config.interface, "config validated");
     if args.check {
