@@ -38,6 +38,27 @@ group = "handstack"
 audit_log = "/var/lib/handstack/audit.log"
 "#;
 
+/// A file with a CiA 402 drive on the index finger and handd's CANopen table (issue 26).
+const VALID_DRIVES: &str = r#"interface = "can0"
+
+[fingers.index]
+kf = 0.8
+
+[fingers.index.drive]
+profile = "cia402"
+node_id = 5
+mode = "cst"
+rated_torque_mnm = 25.0
+gear_ratio = 64.0
+moment_arm_m = 0.04
+max_torque_permille = 1000
+max_speed_rpm = 8000
+
+[canopen]
+master_node_id = 127
+sync_cob_id = 0x07F
+"#;
+
 /// Whether `field` is a field of the file, as `Config::validate` names them.
 fn is_field(field: &str) -> bool {
     const TOP: &[&str] = &[
@@ -53,6 +74,8 @@ fn is_field(field: &str) -> bool {
         "deploy.max_tolerance",
         "deploy.min_rays",
         "state_dir",
+        "canopen.master_node_id",
+        "canopen.sync_cob_id",
     ];
     const FINGER: &[&str] = &[
         "kf",
@@ -63,6 +86,14 @@ fn is_field(field: &str) -> bool {
         "damping",
         "rest_damping",
         "ramp_s",
+        "drive.profile",
+        "drive.node_id",
+        "drive.mode",
+        "drive.rated_torque_mnm",
+        "drive.gear_ratio",
+        "drive.moment_arm_m",
+        "drive.max_torque_permille",
+        "drive.max_speed_rpm",
     ];
     TOP.contains(&field)
         || field.strip_prefix("fingers.").is_some_and(|rest| {
@@ -96,6 +127,8 @@ fn check(bytes: &[u8]) -> Result<(), TestCaseError> {
 fn the_valid_file_parses() {
     let cfg = Config::from_toml(VALID, Path::new("handd.toml")).expect("valid");
     assert_eq!(cfg.fingers.index.kf, 0.8);
+    let cfg = Config::from_toml(VALID_DRIVES, Path::new("handd.toml")).expect("valid");
+    assert!(cfg.drives().expect("valid drives").any_cia402());
 }
 
 // Regression: bytes that are not UTF-8 were refused without saying where.
@@ -125,6 +158,11 @@ proptest! {
 
     #[test]
     fn mutated_files_never_panic(bytes in mutated(VALID.as_bytes().to_vec())) {
+        check(&bytes)?;
+    }
+
+    #[test]
+    fn mutated_drive_tables_never_panic(bytes in mutated(VALID_DRIVES.as_bytes().to_vec())) {
         check(&bytes)?;
     }
 }
