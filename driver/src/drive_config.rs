@@ -164,13 +164,13 @@ fn dbc_message_on(id: u16) -> Option<&'static str> {
 /// Validates every finger's drive against the others, handd's own node and hand.dbc.
 pub fn validate_drives(fingers: &Fingers, canopen: &CanopenConfig) -> Result<Drives, ConfigError> {
     let mut drives = [Drive::Native; N_FINGERS];
-    // Node id -> the finger whose field named it first.
+    // Node id -> the field that named it first.
     let mut taken: BTreeMap<u8, String> = BTreeMap::new();
     for (f, name) in FINGER_NAMES.iter().enumerate().take(N_FINGERS) {
         let d = &fingers.get(f).drive;
         let at = |field: &str| format!("fingers.{name}.drive.{field}");
         if d.profile == Profile::Native {
-            if *d != (DriveConfig::default()) {
+            if *d != DriveConfig::default() {
                 return Err(invalid(
                     at("profile"),
                     "\"native\"",
@@ -179,82 +179,109 @@ pub fn validate_drives(fingers: &Fingers, canopen: &CanopenConfig) -> Result<Dri
             }
             continue;
         }
-        let raw = d
-            .node_id
-            .ok_or_else(|| invalid(at("node_id"), "(missing)", "the drive's node id, 1 to 127"))?;
-        let node = NodeId::try_new(raw).map_err(|_| invalid(at("node_id"), raw, "1 to 127"))?;
-        if let Some(other) = taken.insert(raw, at("node_id")) {
-            return Err(invalid(
-                at("node_id"),
-                raw,
-                format!("a node id no other finger has ({other} is {raw} too)"),
-            ));
-        }
-        if raw == canopen.master_node_id {
-            return Err(invalid(
-                at("node_id"),
-                raw,
-                "another node id than handd's own (canopen.master_node_id)",
-            ));
-        }
-        let clashes: Vec<String> = CobId::all_of(node)
-            .iter()
-            .filter_map(|c| dbc_message_on(c.raw()).map(|m| format!("{:#05x} ({m})", c.raw())))
-            .collect();
-        if !clashes.is_empty() {
-            return Err(invalid(
-                at("node_id"),
-                raw,
-                format!(
-                    "a node whose COB-IDs miss hand.dbc's ids (node {raw} uses {}; nodes 5 to \
-                     127 are clear)",
-                    clashes.join(", ")
-                ),
-            ));
-        }
+        let node = node_of(d, &at, canopen, &mut taken)?;
         let mode = d
             .mode
             .ok_or_else(|| invalid(at("mode"), "(missing)", "\"cst\", \"csv\" or \"pv\""))?
             .mode();
-        let need = |field: &str, v: Option<f64>| {
-            v.ok_or_else(|| invalid(at(field), "(missing)", "required for a cia402 drive"))
-        };
-        let settings = ScalingSettings {
-            rated_torque_mnm: need("rated_torque_mnm", d.rated_torque_mnm)?,
-            gear_ratio: need("gear_ratio", d.gear_ratio)?,
-            moment_arm_m: need("moment_arm_m", d.moment_arm_m)?,
-            max_torque_permille: d
-                .max_torque_permille
-                .ok_or_else(|| invalid(at("max_torque_permille"), "(missing)", "1 to 32767"))?,
-            max_speed_rpm: d
-                .max_speed_rpm
-                .ok_or_else(|| invalid(at("max_speed_rpm"), "(missing)", "1 to 2147483647"))?,
-        };
-        let scaling = settings.validate().map_err(|e| match e {
-            hand_canopen::scaling::ScalingError::NotPositive { field, value } => {
-                invalid(at(field), value, "finite and > 0")
-            }
-            hand_canopen::scaling::ScalingError::Limit(field) => invalid(
-                at(field),
-                match field {
-                    "max_torque_permille" => settings.max_torque_permille.to_string(),
-                    _ => settings.max_speed_rpm.to_string(),
-                },
-                "1 to the drive object's range (32767 per mille, 2147483647 rpm)",
-            ),
-        })?;
         drives[f] = Drive::Cia402 {
             node,
             mode,
-            scaling,
+            scaling: scaling_of(d, &at)?,
         };
     }
-    if taken.is_empty() {
-        return Ok(Drives {
-            fingers: drives,
-            master: None,
-        });
+    let master = if taken.is_empty() {
+        None
+    } else {
+        Some(master_of(canopen, &taken)?)
+    };
+    Ok(Drives {
+        fingers: drives,
+        master,
+    })
+}
+
+/// A cia402 finger's node id: present, in range, no other finger's nor handd's, and its
+/// predefined COB-IDs clear of hand.dbc's ids; recorded in `taken`.
+fn node_of(
+    d: &DriveConfig,
+    at: &dyn Fn(&str) -> String,
+    canopen: &CanopenConfig,
+    taken: &mut BTreeMap<u8, String>,
+) -> Result<NodeId, ConfigError> {
+    let raw = d
+        .node_id
+        .ok_or_else(|| invalid(at("node_id"), "(missing)", "the drive's node id, 1 to 127"))?;
+    let node = NodeId::try_new(raw).map_err(|_| invalid(at("node_id"), raw, "1 to 127"))?;
+    if let Some(other) = taken.insert(raw, at("node_id")) {
+        return Err(invalid(
+            at("node_id"),
+            raw,
+            format!("a node id no other finger has ({other} is {raw} too)"),
+        ));
     }
+    if raw == canopen.master_node_id {
+        return Err(invalid(
+            at("node_id"),
+            raw,
+            "another node id than handd's own (canopen.master_node_id)",
+        ));
+    }
+    let clashes: Vec<String> = CobId::all_of(node)
+        .iter()
+        .filter_map(|c| dbc_message_on(c.raw()).map(|m| format!("{:#05x} ({m})", c.raw())))
+        .collect();
+    if !clashes.is_empty() {
+        return Err(invalid(
+            at("node_id"),
+            raw,
+            format!(
+                "a node whose COB-IDs miss hand.dbc's ids (node {raw} uses {}; nodes 5 to 127 \
+                 are clear)",
+                clashes.join(", ")
+            ),
+        ));
+    }
+    Ok(node)
+}
+
+/// A cia402 finger's scaling: every field present and hand-canopen's checks passed.
+fn scaling_of(d: &DriveConfig, at: &dyn Fn(&str) -> String) -> Result<Scaling, ConfigError> {
+    let need = |field: &str, v: Option<f64>| {
+        v.ok_or_else(|| invalid(at(field), "(missing)", "required for a cia402 drive"))
+    };
+    let settings = ScalingSettings {
+        rated_torque_mnm: need("rated_torque_mnm", d.rated_torque_mnm)?,
+        gear_ratio: need("gear_ratio", d.gear_ratio)?,
+        moment_arm_m: need("moment_arm_m", d.moment_arm_m)?,
+        max_torque_permille: d
+            .max_torque_permille
+            .ok_or_else(|| invalid(at("max_torque_permille"), "(missing)", "1 to 32767"))?,
+        max_speed_rpm: d
+            .max_speed_rpm
+            .ok_or_else(|| invalid(at("max_speed_rpm"), "(missing)", "1 to 2147483647"))?,
+    };
+    settings.validate().map_err(|e| match e {
+        hand_canopen::scaling::ScalingError::NotPositive { field, value } => {
+            invalid(at(field), value, "finite and > 0")
+        }
+        hand_canopen::scaling::ScalingError::Limit(field) => invalid(
+            at(field),
+            match field {
+                "max_torque_permille" => settings.max_torque_permille.to_string(),
+                _ => settings.max_speed_rpm.to_string(),
+            },
+            "1 to the drive object's range (32767 per mille, 2147483647 rpm)",
+        ),
+    })
+}
+
+/// handd's node id and SYNC COB-ID, when a finger has a cia402 drive: the SYNC id on no
+/// hand.dbc id, not NMT's and none of a drive's (the node ids in `taken`).
+fn master_of(
+    canopen: &CanopenConfig,
+    taken: &BTreeMap<u8, String>,
+) -> Result<(NodeId, CobId), ConfigError> {
     let master = NodeId::try_new(canopen.master_node_id).map_err(|_| {
         invalid(
             "canopen.master_node_id".into(),
@@ -291,10 +318,7 @@ pub fn validate_drives(fingers: &Fingers, canopen: &CanopenConfig) -> Result<Dri
             ),
         ));
     }
-    Ok(Drives {
-        fingers: drives,
-        master: Some((master, sync)),
-    })
+    Ok((master, sync))
 }
 
 #[cfg(test)]
