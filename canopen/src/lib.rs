@@ -13,6 +13,8 @@
 //! - [`cia402`]: statusword/controlword, the transition table, the walk to Operation enabled.
 //! - [`scaling`]: daemon units to drive units, validated once.
 //! - [`startup`]: one drive's start-up as data and as a state machine.
+//! - [`master`]: every drive after start-up: the per-tick RPDO1s, SYNC and heartbeat, feedback
+//!   age, latched faults, recovery on `arm`.
 //! - [`sim`] (feature `sim`): a simulated CiA 402 drive node.
 //!
 //! ```
@@ -36,6 +38,7 @@ pub mod emcy;
 pub mod frame;
 pub mod heartbeat;
 pub mod ids;
+pub mod master;
 pub mod nmt;
 pub mod pdo;
 pub mod scaling;
@@ -50,6 +53,7 @@ pub use emcy::Emcy;
 pub use frame::CanFrame;
 pub use heartbeat::{HeartbeatConsumer, HeartbeatProducer};
 pub use ids::{CobId, NodeId, ObjectAddr};
+pub use master::{DriveBank, DriveFault, DriveStatus, Target};
 pub use nmt::{NmtCommand, NmtState};
 pub use sdo::{AbortCode, SdoClient, SdoData, SdoError};
 pub use startup::{Startup, StartupSettings, StartupStatus};
