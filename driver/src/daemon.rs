@@ -493,6 +493,33 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         self.frames_rx += 1;
         self.bus_load.frame(frame);
         self.engine.on_frame(frame, rx_us);
+        self.send_immediate();
+    }
+
+    /// What the engine answers at once (a CiA 402 drive's start-up, step by step at bus
+    /// speed). A full queue drops the rest: that start-up step times out and names itself.
+    fn send_immediate(&mut self) {
+        let mut failed = None;
+        for f in self.engine.take_immediate() {
+            match self.transport.send(f) {
+                Ok(()) => {
+                    self.frames_tx += 1;
+                    self.bus_load.frame(f);
+                }
+                Err(TransportError::QueueFull) => {
+                    self.tx_queue_full += 1;
+                    break;
+                }
+                Err(e) => {
+                    failed = Some(e);
+                    break;
+                }
+            }
+        }
+        if let Some(e) = failed {
+            let now = self.clock.now_us();
+            self.bus_failed(now, &e);
+        }
     }
 
     /// Read every waiting frame received up to `until_us` (the tick's deadline; between ticks,

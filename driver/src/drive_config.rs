@@ -138,6 +138,16 @@ pub struct Drives {
     pub master: Option<(NodeId, CobId)>,
 }
 
+impl Default for Drives {
+    /// Every finger native.
+    fn default() -> Self {
+        Self {
+            fingers: [Drive::Native; N_FINGERS],
+            master: None,
+        }
+    }
+}
+
 impl Drives {
     /// Whether any finger has a CiA 402 drive.
     pub fn any_cia402(&self) -> bool {

@@ -157,7 +157,8 @@ impl LoadedModel {
     }
 }
 
-/// The engine's settings from a validated config.
+/// The engine's settings from a validated config (`Config::load` and `Config::validate`
+/// check the drive table; an unvalidated one with a bad table panics here, naming it).
 pub fn engine_settings(config: &Config, model_id: u32) -> EngineSettings {
     EngineSettings {
         tick_us: config.tick_ms * 1000,
@@ -169,6 +170,9 @@ pub fn engine_settings(config: &Config, model_id: u32) -> EngineSettings {
         gains: std::array::from_fn::<_, N_FINGERS, _>(|f| config.fingers.get(f).gains()),
         model_id,
         plausible_spread: config.plausibility.spread,
+        drives: config
+            .drives()
+            .unwrap_or_else(|e| panic!("the config was validated before: {e}")),
     }
 }
 

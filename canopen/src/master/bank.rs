@@ -202,6 +202,11 @@ impl DriveBank {
         self.slots[k].settings.node
     }
 
+    /// Drive `k`'s operating mode.
+    pub fn mode(&self, k: usize) -> Mode {
+        self.slots[k].settings.mode
+    }
+
     /// Drive `k`'s status.
     pub fn status(&self, k: usize) -> DriveStatus {
         match &self.slots[k].phase {
@@ -355,6 +360,26 @@ impl DriveBank {
         }
         out(sync_frame_on(self.settings.sync_cob_id));
         out(self.heartbeat.frame(NmtState::Operational));
+    }
+}
+
+impl DriveBank {
+    /// At once, outside the tick (the bus came back, handd exits): every configured drive's
+    /// RPDO1 with the quick stop and its target zeroed, then the SYNC that applies them. No
+    /// state changes: the next tick decides again.
+    pub fn stop_frames(&mut self, out: &mut impl FnMut(CanFrame)) {
+        for s in &mut self.slots {
+            if let Phase::Running(r) = &mut s.phase {
+                r.enabled = false;
+                r.walk = None;
+                r.cw = Command::QuickStop.controlword();
+            }
+            if !matches!(s.phase, Phase::Starting(_)) {
+                let (cw, value) = stop();
+                out(rpdo1(s.settings.node, s.settings.mode, cw, value));
+            }
+        }
+        out(sync_frame_on(self.settings.sync_cob_id));
     }
 }
 

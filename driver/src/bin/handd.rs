@@ -194,32 +194,18 @@ fn build_engine(
     (engine, chain)
 }
 
-/// A `cia402` drive passes the config's checks (`driver::drive_config`), but this handd's loop
-/// drives hand.dbc's native fingers only: the CiA 402 master core (`hand-canopen`) is not wired
-/// into it yet (issue 26). handd and `handd --check` refuse such a config, naming the fingers,
-/// rather than run a CANopen drive as if it were native.
-fn refuse_unwired_drives(config: &Config) -> Result<(), String> {
+/// The drive table against the bank it makes at this tick (beyond the config's own checks:
+/// the SYNC period must fit each drive's 0x60C2). handd and `--check` refuse a table that does
+/// not, naming why.
+fn check_drive_bank(config: &Config) -> Result<(), String> {
     let drives = config.drives().map_err(|e| e.to_string())?;
-    let cia402: Vec<&str> = driver::units::FINGER_NAMES
-        .iter()
-        .zip(drives.fingers)
-        .filter(|(_, d)| matches!(d, driver::drive_config::Drive::Cia402 { .. }))
-        .map(|(n, _)| *n)
-        .collect();
-    if cia402.is_empty() {
-        return Ok(());
-    }
-    Err(format!(
-        "fingers.{}.drive: profile = \"cia402\" is valid here, but this handd drives native \
-         (hand.dbc) fingers only: the CiA 402 master is not yet wired into the control loop \
-         (issue 26); set profile = \"native\" or remove the drive table",
-        cia402.join(", fingers.")
-    ))
+    driver::engine::check_drives(&drives, config.tick_ms * 1000)
+        .map_err(|e| format!("fingers.*.drive (CiA 402): {e}"))
 }
 
 fn run(args: &Args) -> Result<(), String> {
     let config = Config::load(&args.config).map_err(|e| e.to_string())?;
-    refuse_unwired_drives(&config)?;
+    check_drive_bank(&config)?;
     let loaded = load_configured(&config, args.check)?;
     tracing::info!(config = %args.config.display(), interface = %config.interface, "config validated");
     if args.check {
@@ -344,6 +330,17 @@ fn print_check(args: &Args, config: &Config, loaded: Option<&LoadedModel>) {
             config.interface,
             l.status(&config.model).verification
         );
+    }
+    if let Ok(drives) = config.drives() {
+        for (name, d) in driver::units::FINGER_NAMES.iter().zip(drives.fingers) {
+            if let driver::drive_config::Drive::Cia402 { node, mode, .. } = d {
+                println!(
+                    "finger {name}: CiA 402 drive, node {node}, mode {} (started, configured \
+                     and enabled by handd at start)",
+                    mode.value()
+                );
+            }
+        }
     }
 }
 

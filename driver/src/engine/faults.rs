@@ -45,6 +45,19 @@ impl Engine {
 
     /// The finger watchdog at `now_us`; its events are kept for [`Engine::drain_events`].
     pub(super) fn update_watch(&mut self, now_us: u64) {
+        // A CiA 402 finger is heard while its drive runs with no latched fault; its force is
+        // the drive's torque actual, scaled back.
+        if let Some(d) = &self.drives {
+            for f in 0..N_FINGERS {
+                if !d.has(f) {
+                    continue;
+                }
+                if d.ready(f) {
+                    self.watch.heard(f, now_us);
+                }
+                self.inputs.reported_force[f] = d.force_n(f).unwrap_or(0.0);
+            }
+        }
         let mut events = [None; N_FINGERS];
         let mut k = 0;
         self.watch.update(now_us, |e| {

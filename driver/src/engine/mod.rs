@@ -16,6 +16,7 @@
 
 #[cfg(test)]
 mod amp_tests;
+mod drives;
 mod epoch;
 mod faults;
 mod rx;
@@ -24,6 +25,7 @@ mod swap;
 mod test_support;
 mod tx;
 
+pub use drives::{bank_settings, check_drives, MAX_IMMEDIATE};
 pub use epoch::{fresh_epoch, fresh_epochs};
 pub use rx::{amp_problem, AmpProblem, AMP_STATUS_SILENCE_US};
 pub use swap::{Hold, ModelSwap, SwapTicket};
@@ -40,8 +42,10 @@ use crate::stats::Histogram;
 use crate::tape::{Entry, Recorded, Recorder};
 use crate::units::N_FINGERS;
 
-/// Most frames one tick sends: five setpoints, HAND_DIAG and HAND_HEARTBEAT.
-pub const MAX_TX_PER_TICK: usize = N_FINGERS + 2;
+/// Most frames one tick sends: five setpoints (FINGER_SETPOINT or a CiA 402 drive's RPDO1),
+/// HAND_DIAG and HAND_HEARTBEAT; with CiA 402 drives also SYNC, handd's CANopen heartbeat and
+/// up to two start-up frames per drive.
+pub const MAX_TX_PER_TICK: usize = 3 * N_FINGERS + 4;
 
 /// Timing and gains of the engine, taken from the validated config.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -65,6 +69,8 @@ pub struct EngineSettings {
     /// The spread of the input plausibility check (`decoder::model::Envelope::implausible`),
     /// applied to every model the engine runs.
     pub plausible_spread: f64,
+    /// Each finger's drive: native (hand.dbc's FINGER_SETPOINT) or a CiA 402 drive.
+    pub drives: crate::drive_config::Drives,
 }
 
 impl Default for EngineSettings {
@@ -79,6 +85,7 @@ impl Default for EngineSettings {
             gains: [FingerGains::default(); N_FINGERS],
             model_id: 0,
             plausible_spread: decoder::model::PLAUSIBLE_SPREAD,
+            drives: crate::drive_config::Drives::default(),
         }
     }
 }
@@ -153,6 +160,8 @@ pub struct Engine {
     counters: Counters,
     timing: TickTiming,
     tx: tx::Tx,
+    /// The CiA 402 drives, when a finger has one.
+    drives: Option<drives::Drives>,
     epochs: epoch::Epochs,
     transitions: [Option<Transition>; 8],
     finger_events: [Option<FingerEvent>; N_FINGERS],
@@ -220,6 +229,8 @@ impl Engine {
             counters: Counters::default(),
             timing: TickTiming::default(),
             tx: tx::Tx::new(),
+            drives: drives::Drives::try_new(&settings.drives, settings.tick_us)
+                .expect("the drive table was checked (check_drives) before the engine"),
             epochs: epoch::Epochs::new(epochs),
             transitions: [None; 8],
             finger_events: [None; N_FINGERS],
@@ -292,6 +303,10 @@ impl Engine {
     pub fn new_epoch(&mut self) {
         self.record(Entry::NewEpoch);
         self.epochs.next();
+        // The drives' NMT and CiA 402 states are unknown after a bus failure.
+        if let Some(d) = &mut self.drives {
+            d.bus_recovered();
+        }
     }
 
     /// The setpoint epoch finger `f`'s frames carry now.
@@ -415,7 +430,7 @@ impl Engine {
         let t = self.safety.update(now_us, valid);
         self.note(t);
         self.update_watch(now_us);
-        self.transmit();
+        self.transmit(now_us);
         self.record_out()
     }
 
@@ -567,6 +582,25 @@ impl Engine {
     /// Whether finger `f` is disabled.
     pub fn finger_disabled(&self, f: usize) -> bool {
         self.watch.is_disabled(f)
+    }
+    /// Finger `f`'s CiA 402 drive status (`None`: a native finger).
+    pub fn drive_status(&self, f: usize) -> Option<hand_canopen::DriveStatus> {
+        self.drives.as_ref().and_then(|d| d.status(f))
+    }
+    /// Frames to send at once, outside the tick (a CiA 402 drive's start-up answered at bus
+    /// speed), taken from the engine: the caller sends them right after the frame that made
+    /// them. Put on the tape too.
+    pub fn take_immediate(&mut self) -> &[CanFrame] {
+        let Some(d) = &mut self.drives else {
+            return &[];
+        };
+        let frames = d.take_immediate();
+        if let Some(tape) = &mut self.tape {
+            for &frame in frames {
+                tape.put(Entry::Out { frame });
+            }
+        }
+        frames
     }
     /// EMG samples pushed into the chain since start.
     pub fn samples_in(&self) -> u64 {

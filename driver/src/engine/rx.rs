@@ -304,6 +304,10 @@ impl Engine {
             self.counters.bad_frames += 1;
             return;
         }
+        if let Some(d) = self.drives.as_mut().filter(|d| d.claims(frame)) {
+            d.on_frame(frame, rx_us);
+            return;
+        }
         match self.emg.on_frame(frame, rx_us) {
             FrameVerdict::NotEmg => {}
             FrameVerdict::Accepted => {
@@ -335,6 +339,9 @@ impl Engine {
     /// A decoded frame other than EMG samples.
     fn on_message(&mut self, msg: &Message, data: &[u8], rx_us: u64) {
         match msg {
+            // A CiA 402 finger's state comes from its drive, not from hand.dbc.
+            Message::FingerStatus(s)
+                if self.drives.as_ref().is_some_and(|d| d.has(s.instance())) => {}
             Message::FingerStatus(s) => {
                 let f = s.instance();
                 match self.inputs.status[f].check(Some(data)) {

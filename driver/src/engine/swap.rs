@@ -127,6 +127,10 @@ impl Engine {
         }
         self.safety.arm(now_us)?;
         self.hold = Hold::Free;
+        // Every CiA 402 drive with a latched fault starts again from scratch.
+        if let Some(d) = &mut self.drives {
+            d.arm();
+        }
         Ok(())
     }
 

@@ -38,8 +38,11 @@ impl Tx {
 
     fn push(&mut self, frame: Option<CanFrame>) {
         if let Some(frame) = frame {
-            self.frames[self.len] = frame;
-            self.len += 1;
+            // MAX_TX_PER_TICK covers every tick; never a panic on the tick path.
+            if self.len < MAX_TX_PER_TICK {
+                self.frames[self.len] = frame;
+                self.len += 1;
+            }
         }
     }
 
@@ -77,6 +80,10 @@ impl Engine {
     pub(super) fn build_setpoints(&mut self, running: bool) {
         let dt_s = self.settings.tick_us as f64 * 1e-6;
         for f in 0..N_FINGERS {
+            if self.drives.as_ref().is_some_and(|d| d.has(f)) {
+                self.build_drive_setpoint(f, running, dt_s);
+                continue;
+            }
             let wanted = if running && !self.watch.is_disabled(f) {
                 FingerMode::Active
             } else {
@@ -94,6 +101,49 @@ impl Engine {
             }
             self.tx
                 .setpoint(f, mode, &self.setpoints[f], self.epochs.current(f));
+        }
+    }
+
+    /// A CiA 402 finger's setpoint, as its drive's target (its RPDO1 leaves with the bank's
+    /// frames). It is conditioned only while the drive follows its target, so a drive walked
+    /// back to Operation enabled starts from rest; until then its target is 0.
+    fn build_drive_setpoint(&mut self, f: usize, running: bool, dt_s: f64) {
+        let Some(d) = self.drives.as_mut() else {
+            return;
+        };
+        if running && d.ready(f) {
+            if d.enabled(f) {
+                let gains = &self.settings.gains[f];
+                let feedback = crate::conditioner::Feedback {
+                    at_joint_limit: d.at_limit(f),
+                };
+                self.setpoints[f] =
+                    self.conditioners[f].step(self.labels[f], gains, dt_s, feedback);
+            } else {
+                self.conditioners[f].reset();
+                self.setpoints[f] = Setpoint::default();
+            }
+            d.set_target(f, Some(&self.setpoints[f]));
+        } else {
+            self.conditioners[f].reset();
+            self.setpoints[f] = Setpoint::default();
+            d.set_target(f, None);
+        }
+    }
+
+    /// The CiA 402 drives' frames of the tick: RPDO1 per drive, SYNC, heartbeat.
+    fn build_drive_frames(&mut self, now_us: u64) {
+        if let Some(d) = &mut self.drives {
+            let tx = &mut self.tx;
+            d.tick(now_us, |f| tx.push(Some(f)));
+        }
+    }
+
+    /// Every CiA 402 drive's quick stop with its target zeroed, and the SYNC that applies it.
+    fn build_drive_stops(&mut self) {
+        if let Some(d) = &mut self.drives {
+            let tx = &mut self.tx;
+            d.stop_frames(|f| tx.push(Some(f)));
         }
     }
 
@@ -141,10 +191,11 @@ impl Engine {
     }
 
     /// The tick's frames, built anew: setpoints, HAND_DIAG, HAND_HEARTBEAT.
-    pub(super) fn transmit(&mut self) -> &[CanFrame] {
+    pub(super) fn transmit(&mut self, now_us: u64) -> &[CanFrame] {
         self.tx.clear();
         let running = self.safety.outputs_enabled();
         self.build_setpoints(running);
+        self.build_drive_frames(now_us);
         self.build_diag(running);
         self.build_heartbeat();
         self.tx.frames()
@@ -159,6 +210,7 @@ impl Engine {
         self.tx.clear();
         if !self.safety.outputs_enabled() {
             self.build_setpoints(false);
+            self.build_drive_stops();
         }
         self.record_out()
     }
@@ -175,6 +227,7 @@ impl Engine {
         self.tx.clear();
         self.epochs.next();
         self.build_setpoints(false);
+        self.build_drive_stops();
         self.record_out()
     }
 }
@@ -220,7 +273,7 @@ mod tests {
         // Losing samples takes an EMG stream with gaps; the counter it feeds is set directly.
         for (lost, expected) in [(255, 255), (256, 0), (511, 255), (600, 88)] {
             e.counters.samples_lost = lost;
-            let d = diag(e.transmit());
+            let d = diag(e.transmit(0));
             assert_eq!(d.emg_samples_lost(), expected, "{lost} samples lost");
         }
     }

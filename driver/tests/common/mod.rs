@@ -101,6 +101,25 @@ impl<T: Transport> Rig<T> {
         wrap: impl FnOnce(MemTransport<VirtualClock>) -> T,
         bus: impl FnOnce(MemBus) -> MemBus,
     ) -> Self {
+        Self::with_settings(
+            faults,
+            patient,
+            predictor,
+            wrap,
+            bus,
+            EngineSettings::default(),
+        )
+    }
+
+    /// As [`Rig::with_bus`], with the engine's settings (a finger's CiA 402 drive, say).
+    pub fn with_settings(
+        faults: FaultPlan,
+        patient: PatientMode,
+        predictor: Predictor,
+        wrap: impl FnOnce(MemTransport<VirtualClock>) -> T,
+        bus: impl FnOnce(MemBus) -> MemBus,
+        settings: EngineSettings,
+    ) -> Self {
         let clock = VirtualClock::new();
         let bus = bus(MemBus::with_clock(clock.clone()));
         let b = bus.clone();
@@ -114,7 +133,7 @@ impl<T: Transport> Rig<T> {
         )
         .unwrap();
         let chain = ChainConfig::default().validate().unwrap();
-        let mut engine = Engine::new(&chain, predictor, EngineSettings::default(), 0);
+        let mut engine = Engine::new(&chain, predictor, settings, 0);
         engine.validated(0);
         let transport = wrap(MemTransport::new(bus.endpoint(), clock.clone()));
         let runner = Runner::new(engine, transport, clock.clone(), 50_000);
