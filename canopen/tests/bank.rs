@@ -67,6 +67,9 @@ impl Hand {
         let mut queue: Vec<(bool, CanFrame)> = from_bank.into_iter().map(|f| (true, f)).collect();
         queue.reverse();
         while let Some((by_bank, f)) = queue.pop() {
+            // A frame takes time on the bus (about 100 us at 1 Mbit/s): an answer is never
+            // received at the instant its request was sent.
+            self.now += 100;
             let now = self.now;
             let mut answers = Vec::new();
             if by_bank {

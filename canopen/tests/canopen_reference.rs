@@ -176,6 +176,8 @@ impl Master {
         let mut queue = first;
         while !queue.is_empty() {
             let f = queue.remove(0);
+            // An answer arrives after its request was sent (about 100 us at 1 Mbit/s).
+            self.now += 100;
             for r in py.frame(&f, self.now) {
                 queue.extend(self.startup.on_frame(&r, self.now));
             }

@@ -268,3 +268,26 @@ fn an_unsupported_mode_is_refused_at_its_step() {
         StepFailure::ModeUnsupported { mode: 3, .. }
     ));
 }
+
+#[test]
+fn a_boot_up_from_before_the_reset_is_not_taken_as_its_answer() {
+    let mut b = Bench::new(settings(Mode::CyclicSyncTorque));
+    let mut queued = Vec::new();
+    b.drive.power_on(0, &mut queued);
+    let old_boot_up = queued[0];
+    // The reset goes out at 1 ms; the power-on boot-up, still queued, is read at the same time.
+    let reset = b.startup.poll(1_000).expect("the reset communication");
+    assert_eq!(reset.cob_id(), 0x000);
+    assert!(b.startup.poll(1_000).is_none(), "waiting for the boot-up");
+    assert!(b.startup.on_frame(&old_boot_up, 1_000).is_none());
+    assert_eq!(
+        b.startup.status(),
+        StartupStatus::Running(Step::AwaitBootUp)
+    );
+    // The answer to the reset, read after it was sent, is.
+    assert!(b.startup.on_frame(&old_boot_up, 1_200).is_none());
+    assert_eq!(
+        b.startup.status(),
+        StartupStatus::Running(Step::ReadIdentity(1))
+    );
+}

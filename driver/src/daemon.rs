@@ -93,6 +93,8 @@ pub struct Snapshot {
     pub publish_skips: u64,
     /// The CAN controller's error state and every bus error class, counted.
     pub bus: BusHealth,
+    /// Each CiA 402 finger's drive: its node id and status (`None`: a native finger).
+    pub drives: [Option<(u8, hand_canopen::DriveStatus)>; N_FINGERS],
 }
 
 impl Default for Snapshot {
@@ -124,6 +126,7 @@ impl Default for Snapshot {
             bus_load: 0.0,
             publish_skips: 0,
             bus: BusHealth::default(),
+            drives: [None; N_FINGERS],
         }
     }
 }
@@ -706,6 +709,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             bus_load: self.bus_load.load(),
             publish_skips: self.publish_skips,
             bus: self.bus_health(),
+            drives: std::array::from_fn(|f| e.drive(f)),
         };
         match self.snapshot.try_lock() {
             Ok(mut s) => *s = snap,

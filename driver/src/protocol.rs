@@ -144,6 +144,55 @@ pub struct Status {
     /// a daemon older than this field).
     #[serde(default)]
     pub bus: BusStatus,
+    /// Each CiA 402 finger's drive (none when every finger is native, and from a daemon older
+    /// than this field).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub drives: Vec<DriveLine>,
+}
+
+/// One CiA 402 finger's drive as `handctl status` shows it.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub struct DriveLine {
+    /// The finger.
+    pub finger: String,
+    /// The drive's node id.
+    pub node: u8,
+    /// What it is doing, or why it is stopped.
+    pub state: String,
+    /// A latched fault: the finger is stopped until `handctl arm`.
+    pub faulted: bool,
+}
+
+impl DriveLine {
+    /// The line for finger `finger`'s drive on `node` in `status`.
+    pub fn of(finger: &str, node: u8, status: &hand_canopen::DriveStatus) -> Self {
+        use hand_canopen::DriveStatus as S;
+        let state = match status {
+            S::Starting(step) => format!("starting: {step}"),
+            S::Running {
+                enabled, identity, ..
+            } => format!(
+                "{} (vendor 0x{:08X}{})",
+                if *enabled {
+                    "Operation enabled, following its setpoint"
+                } else {
+                    "held in quick stop (handd is not running the hand)"
+                },
+                identity.vendor,
+                identity
+                    .product
+                    .map(|p| format!(", product 0x{p:08X}"))
+                    .unwrap_or_default()
+            ),
+            S::Faulted(fault) => format!("stopped: {fault}; `handctl arm` starts it again"),
+        };
+        Self {
+            finger: finger.into(),
+            node,
+            state,
+            faulted: matches!(status, S::Faulted(_)),
+        }
+    }
 }
 
 /// The CAN bus as `handctl status` shows it.

@@ -83,7 +83,8 @@ impl Hand {
         Self { rig, drive, port }
     }
 
-    /// As `Rig::run_until`, with the drive node served every 1 ms step.
+    /// As `Rig::run_until`, with the drive node served every 1 ms step (before handd: what
+    /// handd sends, the drive answers at the next step, never at the instant it was sent).
     fn run_until(&mut self, t_end_us: u64) {
         let mut now = self.rig.clock_now();
         while now < t_end_us {
@@ -96,7 +97,6 @@ impl Hand {
             } else if now >= self.rig.runner.next_wake_us() {
                 self.rig.runner.service_bus();
             }
-            self.serve_drive(now);
             while let Some(r) = self.rig.probe.receive_timestamped() {
                 self.rig.seen.push((r.time_us.unwrap_or(now), r.frame));
             }

@@ -72,6 +72,7 @@ impl SocketCanBus {
         use socketcan::SocketOptions;
         let set = match listens {
             Listens::Nothing => bus.socket.set_filter_drop_all(),
+            Listens::Everything => bus.socket.set_filter_accept_all(),
             Listens::To(ids) => {
                 // Standard ids, exactly: the mask covers the 11 id bits and the extended-frame
                 // flag, so an extended frame with the same low bits does not pass.

@@ -10,7 +10,8 @@ use crate::error::SimError;
 use crate::faults::FaultPlan;
 use crate::finger::{FingerConfig, N_FINGERS};
 use crate::nodes::{
-    std_id, AmplifierNode, AmplifierNodeConfig, Bus, FaultInjector, FingerNode, NodeStats,
+    std_id, AmplifierNode, AmplifierNodeConfig, Bus, DriveFingerConfig, DriveFingerNode,
+    FaultInjector, FingerNode, NodeStats,
 };
 use crate::patient::{ClosedLoopUser, CuedConfig, CuedPatient, Intent, Script};
 
@@ -41,6 +42,7 @@ pub struct World<B: Bus> {
     patient_stats: NodeStats,
     amp: Option<(AmplifierNode, B)>,
     fingers: Vec<(FingerNode, B)>,
+    drives: Vec<(DriveFingerNode, B)>,
     injector: (FaultInjector, B),
     intent: Intent,
 }
@@ -76,6 +78,9 @@ pub struct WorldConfig {
     pub nodes: NodeSelection,
     /// Node time at which the scenario starts (scripts count from here), µs.
     pub start_us: u64,
+    /// Fingers moved by a simulated CiA 402 drive instead of a native controller (the native
+    /// one does not run for them).
+    pub drives: [Option<DriveFingerConfig>; N_FINGERS],
 }
 
 /// The standard CAN ids one node reads: what a real node's acceptance filter would pass.
@@ -88,6 +93,8 @@ pub enum Listens {
     Nothing,
     /// These ids only.
     To(&'static [u32]),
+    /// Every frame (a CANopen drive, whose ids depend on its node id).
+    Everything,
 }
 
 impl Listens {
@@ -96,6 +103,7 @@ impl Listens {
         match self {
             Listens::Nothing => false,
             Listens::To(ids) => ids.contains(&id),
+            Listens::Everything => true,
         }
     }
 }
@@ -160,8 +168,12 @@ impl<B: Bus> World<B> {
             None
         };
         let mut fingers = Vec::new();
+        let mut drives = Vec::new();
         for (f, listens) in FINGER_LISTENS.iter().enumerate() {
-            if cfg.nodes.fingers & (1 << f) != 0 {
+            if let Some(d) = cfg.drives[f] {
+                let node = DriveFingerNode::try_new(f, cfg.finger, d, cfg.start_us)?;
+                drives.push((node, open(Listens::Everything)?));
+            } else if cfg.nodes.fingers & (1 << f) != 0 {
                 let mut node = FingerNode::try_new(f, cfg.finger, cfg.start_us)?;
                 node.set_faults(cfg.faults.clone());
                 fingers.push((node, open(Listens::To(listens))?));
@@ -174,6 +186,7 @@ impl<B: Bus> World<B> {
             patient_stats: NodeStats::default(),
             amp,
             fingers,
+            drives,
             injector,
             intent: Intent::REST,
         })
@@ -208,6 +221,9 @@ impl<B: Bus> World<B> {
         for (node, bus) in &mut self.fingers {
             node.poll(now_us, bus);
         }
+        for (node, bus) in &mut self.drives {
+            node.poll(now_us, bus);
+        }
         self.injector.0.poll(now_us, &mut self.injector.1);
     }
 
@@ -231,6 +247,19 @@ impl<B: Bus> World<B> {
         self.fingers.iter().map(|(n, _)| n)
     }
 
+    /// The fingers moved by a CiA 402 drive.
+    pub fn drive_fingers(&self) -> impl Iterator<Item = &DriveFingerNode> {
+        self.drives.iter().map(|(n, _)| n)
+    }
+
+    /// Finger `finger`'s CiA 402 drive, to script its faults (a trip, a power cycle).
+    pub fn drive_finger_mut(&mut self, finger: usize) -> Option<&mut DriveFingerNode> {
+        self.drives
+            .iter_mut()
+            .map(|(n, _)| n)
+            .find(|n| n.finger() == finger)
+    }
+
     /// The fault injector.
     pub fn injector(&self) -> &FaultInjector {
         &self.injector.0
@@ -242,6 +271,11 @@ impl<B: Bus> World<B> {
             + self.injector.0.stats().tx_frames
             + self
                 .fingers
+                .iter()
+                .map(|(n, _)| n.stats().tx_frames)
+                .sum::<u64>()
+            + self
+                .drives
                 .iter()
                 .map(|(n, _)| n.stats().tx_frames)
                 .sum::<u64>()

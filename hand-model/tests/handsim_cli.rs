@@ -159,3 +159,29 @@ fn cued_scenario_rests_without_cues_and_takes_a_weak_trial_only_when_cued() {
         "{help}"
     );
 }
+
+#[test]
+fn cia402_fingers_are_drive_nodes_and_a_bad_finger_is_named() {
+    // Index and middle through CiA 402 drives (nodes 6 and 7): their boot-ups and heartbeats
+    // are on the bus, and their native controllers' FINGER_STATUS_1 and _2 are not.
+    let out = handsim(&["--mem", "--cia402", "12", "--duration", "1"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    for present in ["0x0706", "0x0707", "0x0280"] {
+        assert!(text.contains(present), "{present}: {text}");
+    }
+    for absent in ["0x0281", "0x0282", "0x0705"] {
+        assert!(!text.contains(absent), "{absent}: {text}");
+    }
+    let out = handsim(&["--mem", "--cia402", "7", "--duration", "1"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--cia402 \"7\": use finger digits 0 (thumb) to 4 (pinky)"),
+        "{err}"
+    );
+}

@@ -141,6 +141,18 @@ pub fn format_status(s: &Status) -> String {
             if st.disabled { "DISABLED" } else { "" }
         ));
     }
+    if !s.drives.is_empty() {
+        out += "\nCiA 402 drives\n";
+        for d in &s.drives {
+            out += &format!(
+                "{}{:<7} node {:>3}  {}\n",
+                if d.faulted { "!! " } else { "" },
+                d.finger,
+                d.node,
+                d.state
+            );
+        }
+    }
     out
 }
 
@@ -251,5 +263,47 @@ mod tests {
         assert!(json.get("model").is_none());
         let back: Status = serde_json::from_value(json).unwrap();
         assert_eq!(back.model, None);
+    }
+
+    #[test]
+    fn status_lists_each_cia402_drive_and_flags_a_stopped_one() {
+        use driver::protocol::DriveLine;
+        use hand_canopen::master::{DriveFault, DriveStatus};
+        use hand_canopen::startup::Identity;
+        let running = DriveStatus::Running {
+            enabled: true,
+            identity: Identity {
+                vendor: 0xFB,
+                product: Some(0x6050_0000),
+                ..Identity::default()
+            },
+            feedback: None,
+        };
+        let s = Status {
+            drives: vec![
+                DriveLine::of("index", 5, &running),
+                DriveLine::of("middle", 6, &DriveStatus::Faulted(DriveFault::Rebooted)),
+            ],
+            ..Status::default()
+        };
+        let text = format_status(&s);
+        assert!(
+            text.contains(
+                "\nCiA 402 drives\nindex   node   5  Operation enabled, following its setpoint \
+                 (vendor 0x000000FB, product 0x60500000)\n"
+            ),
+            "{text}"
+        );
+        assert!(
+            text.contains(
+                "\n!! middle  node   6  stopped: booted while configured (power cycle or reset); \
+                 reconfigured on arm; `handctl arm` starts it again\n"
+            ),
+            "{text}"
+        );
+        // Every finger native: no drive section, and the field is not sent.
+        assert!(!format_status(&Status::default()).contains("CiA 402"));
+        let json = serde_json::to_value(Status::default()).unwrap();
+        assert!(json.get("drives").is_none());
     }
 }

@@ -289,9 +289,16 @@ impl DriveBank {
                     if let Some(reply) = st.on_frame(f, now_us) {
                         out(reply);
                     }
-                    // The next step goes out at bus speed, not at the next tick.
-                    while let Some(next) = st.poll(now_us) {
-                        out(next);
+                    // The next step goes out at bus speed, not at the next tick; but the reset
+                    // that begins a start-up only at a tick, after every frame received up to
+                    // it was read, so a boot-up read later is the answer to it.
+                    if !matches!(
+                        st.status(),
+                        StartupStatus::Running(Step::ResetCommunication)
+                    ) {
+                        while let Some(next) = st.poll(now_us) {
+                            out(next);
+                        }
                     }
                     continue;
                 }

@@ -109,6 +109,9 @@ pub struct Startup {
     identity: Identity,
     supported_modes: u32,
     failed: Option<StartupError>,
+    /// When the reset communication went out: only a boot-up received after it answers it
+    /// (one sent before, at the drive's power-on, may still be queued).
+    reset_sent_us: u64,
 }
 
 fn masked_equal(expected: SdoData, got: SdoData) -> bool {
@@ -136,6 +139,7 @@ impl Startup {
             identity: Identity::default(),
             supported_modes: 0,
             failed: None,
+            reset_sent_us: 0,
         }
     }
 
@@ -190,6 +194,7 @@ impl Startup {
         let node = self.node;
         let sent = match step {
             Step::ResetCommunication => {
+                self.reset_sent_us = now_us;
                 self.next_step();
                 return Some(NmtCommand::ResetCommunication.frame(Some(node)));
             }
@@ -242,7 +247,10 @@ impl Startup {
         if let Ok(ec) = ErrorControl::decode(f) {
             if ec.node == self.node && ec.is_boot_up() {
                 if step == Step::AwaitBootUp {
-                    self.next_step();
+                    // A boot-up received no later than the reset was sent is an older one.
+                    if now_us > self.reset_sent_us {
+                        self.next_step();
+                    }
                 } else if self.at > 1 {
                     self.fail(step, StepFailure::UnexpectedBootUp);
                 }

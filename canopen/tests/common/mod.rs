@@ -67,6 +67,8 @@ impl Bench {
     pub fn send(&mut self, f: CanFrame) {
         let mut queue = vec![f];
         while let Some(f) = queue.pop() {
+            // An answer arrives after its request was sent (about 100 us at 1 Mbit/s).
+            self.now += 100;
             self.to_drive.push(f);
             let mut out = Vec::new();
             self.drive.on_frame(&f, self.now, &mut out);

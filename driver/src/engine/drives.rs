@@ -135,6 +135,11 @@ impl Drives {
         self.slot[f].is_some_and(|(k, _)| self.bank.is_enabled(k))
     }
 
+    /// Finger `f`'s drive's node id, if it has one.
+    pub(super) fn node(&self, f: usize) -> Option<u8> {
+        self.slot[f].map(|(k, _)| self.bank.node(k).get())
+    }
+
     /// Finger `f`'s drive status, if it has one.
     pub(super) fn status(&self, f: usize) -> Option<DriveStatus> {
         self.slot[f].map(|(k, _)| self.bank.status(k))

@@ -587,6 +587,12 @@ impl Engine {
     pub fn drive_status(&self, f: usize) -> Option<hand_canopen::DriveStatus> {
         self.drives.as_ref().and_then(|d| d.status(f))
     }
+    /// Finger `f`'s CiA 402 drive: its node id and status (`None`: a native finger).
+    pub fn drive(&self, f: usize) -> Option<(u8, hand_canopen::DriveStatus)> {
+        self.drives
+            .as_ref()
+            .and_then(|d| Some((d.node(f)?, d.status(f)?)))
+    }
     /// Frames to send at once, outside the tick (a CiA 402 drive's start-up answered at bus
     /// speed), taken from the engine: the caller sends them right after the frame that made
     /// them. Put on the tape too.

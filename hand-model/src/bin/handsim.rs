@@ -68,6 +68,12 @@ struct Args {
     /// Run the motor controllers of these fingers only, e.g. `013` (default: 01234; `none`).
     #[arg(long, default_value = "01234")]
     fingers: String,
+    /// Move these fingers by a simulated CANopen CiA 402 drive instead of a native controller,
+    /// e.g. `1` (the index): finger F's drive is node 5+F (thumb 5 .. pinky 9), with the scaling
+    /// of the example in handd.toml (rated torque 25 mNm, gear 64, moment arm 0.04 m, limits
+    /// 1000 per mille and 8000 rpm). handd needs the matching `[fingers.NAME.drive]` tables.
+    #[arg(long, value_name = "FINGERS")]
+    cia402: Option<String>,
     /// Write the scenario's calibration trials (session.toml `[[trial]]` form) to this file.
     #[arg(long)]
     trials_out: Option<std::path::PathBuf>,
@@ -120,6 +126,38 @@ fn parse_fault(spec: &str, duration_us: u64) -> Result<(Fault, u64, u64), SimErr
         }
     };
     Ok((fault, from, until))
+}
+
+/// The simulated CiA 402 drives `--cia402 FINGERS` asks for.
+fn sim_drives(
+    fingers: Option<&str>,
+) -> Result<[Option<hand_model::nodes::DriveFingerConfig>; 5], SimError> {
+    let mut out = [None; 5];
+    let Some(s) = fingers else {
+        return Ok(out);
+    };
+    let mask = parse_fingers(s).map_err(|_| {
+        SimError::BadScript(format!(
+            "--cia402 {s:?}: use finger digits 0 (thumb) to 4 (pinky), e.g. 1 or 012"
+        ))
+    })?;
+    let scaling = hand_canopen::scaling::ScalingSettings {
+        rated_torque_mnm: 25.0,
+        gear_ratio: 64.0,
+        moment_arm_m: 0.04,
+        max_torque_permille: 1000,
+        max_speed_rpm: 8000,
+    }
+    .validate()
+    .map_err(|e| SimError::BadScript(format!("--cia402: {e}")))?;
+    for (f, slot) in out.iter_mut().enumerate() {
+        if mask & (1 << f) != 0 {
+            let node = hand_canopen::NodeId::try_new(5 + f as u8)
+                .map_err(|e| SimError::BadScript(format!("--cia402: {e}")))?;
+            *slot = Some(hand_model::nodes::DriveFingerConfig { node, scaling });
+        }
+    }
+    Ok(out)
 }
 
 fn parse_fingers(s: &str) -> Result<u8, SimError> {
@@ -218,6 +256,7 @@ fn run() -> Result<(), String> {
             fingers: parse_fingers(&args.fingers).map_err(|e| e.to_string())?,
         },
         start_us: 0,
+        drives: sim_drives(args.cia402.as_deref()).map_err(|e| e.to_string())?,
     };
     match (&args.iface, args.mem) {
         (Some(iface), false) => {

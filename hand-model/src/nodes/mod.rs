@@ -4,12 +4,14 @@
 //! over SocketCAN in `handsim`.
 
 pub mod amplifier;
+pub mod drive;
 pub mod epoch;
 pub mod injector;
 pub mod motor;
 pub mod setpoints;
 
 pub use amplifier::{AmplifierNode, AmplifierNodeConfig};
+pub use drive::{DriveFingerConfig, DriveFingerNode};
 pub use epoch::EpochGate;
 pub use injector::FaultInjector;
 pub use motor::FingerNode;

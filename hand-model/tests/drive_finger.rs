@@ -1,0 +1,210 @@
+//! A finger moved by its simulated CiA 402 drive (issue 26 item 6), driven by handd's CANopen
+//! master core (`hand_canopen::master::DriveBank`) over the in-memory bus: the drive starts,
+//! a torque target flexes the finger and an opposite one extends it, a stop brakes it, and a
+//! drive fault (EMCY) or a power cycle reaches the master as a latched fault.
+
+use hand_canopen::master::{BankSettings, DriveBank, DriveFault, DriveStatus, Target};
+use hand_canopen::scaling::ScalingSettings;
+use hand_canopen::{CobId, Mode, NodeId, PowerState};
+use hand_model::dbc::CanFrame;
+use hand_model::faults::FaultPlan;
+use hand_model::nodes::DriveFingerConfig;
+use hand_model::patient::Script;
+use hand_model::world::{PatientMode, World, WorldConfig};
+use hand_model::{MemBus, MemEndpoint};
+
+const INDEX: usize = 1;
+const TICK_US: u64 = 50_000;
+
+fn node() -> NodeId {
+    NodeId::try_new(5).expect("in range")
+}
+
+struct Rig {
+    now: u64,
+    world: World<MemEndpoint>,
+    bank: DriveBank,
+    master: MemEndpoint,
+}
+
+impl Rig {
+    fn new(mode: Mode) -> Self {
+        let scaling = ScalingSettings {
+            rated_torque_mnm: 25.0,
+            gear_ratio: 64.0,
+            moment_arm_m: 0.04,
+            max_torque_permille: 1000,
+            max_speed_rpm: 8000,
+        }
+        .validate()
+        .expect("valid scaling");
+        let bus = MemBus::new();
+        let b = bus.clone();
+        let mut drives = [None; 5];
+        drives[INDEX] = Some(DriveFingerConfig {
+            node: node(),
+            scaling,
+        });
+        let world = World::try_new(
+            WorldConfig {
+                faults: FaultPlan::new(),
+                drives,
+                ..WorldConfig::default()
+            },
+            PatientMode::Script(Script::resting(60_000_000)),
+            || Ok::<_, String>(b.endpoint()),
+        )
+        .expect("world");
+        let bank = DriveBank::try_new(
+            BankSettings {
+                master: NodeId::try_new(127).expect("in range"),
+                tick_us: TICK_US as u32,
+                sync_cob_id: CobId::try_new(0x07F).expect("11 bits"),
+                master_heartbeat_timeout_ms: 150,
+                drive_heartbeat_ms: 50,
+                drive_heartbeat_timeout_us: 150_000,
+                sdo_timeout_us: 20_000,
+                step_timeout_us: 500_000,
+            },
+            &[(node(), mode)],
+        )
+        .expect("bank");
+        Self {
+            now: 0,
+            world,
+            bank,
+            master: bus.endpoint(),
+        }
+    }
+
+    fn send(&mut self, f: hand_canopen::CanFrame) {
+        let frame = CanFrame::new_standard(f.cob_id(), f.payload()).expect("11-bit frame");
+        self.master.send(&frame).expect("the bus takes it");
+    }
+
+    /// Runs `us` in 1 ms steps with `target`, the master ticking every 50 ms.
+    fn run(&mut self, us: u64, target: Target) {
+        let end = self.now + us;
+        while self.now < end {
+            self.now += 1000;
+            self.world.step(self.now);
+            let mut out = Vec::new();
+            while let Some(r) = self.master.receive_timestamped() {
+                if let Some(f) =
+                    hand_canopen::CanFrame::new(r.frame.raw_id() as u16, r.frame.data())
+                {
+                    self.bank.on_frame(&f, self.now, &mut |x| out.push(x));
+                }
+            }
+            if self.now.is_multiple_of(TICK_US) {
+                self.bank.tick(self.now, &[target], &mut |x| out.push(x));
+            }
+            for f in out {
+                self.send(f);
+            }
+        }
+    }
+
+    fn angle(&self) -> f64 {
+        self.world
+            .drive_fingers()
+            .find(|n| n.finger() == INDEX)
+            .expect("the index finger's drive")
+            .physics()
+            .angle_rad
+    }
+
+    fn power(&self) -> PowerState {
+        self.world
+            .drive_fingers()
+            .next()
+            .expect("one drive")
+            .drive()
+            .power_state()
+    }
+}
+
+#[test]
+fn the_drive_starts_and_its_torque_moves_the_finger_both_ways() {
+    let mut r = Rig::new(Mode::CyclicSyncTorque);
+    assert_eq!(
+        r.world.fingers().count(),
+        4,
+        "no native controller for the index"
+    );
+    r.run(300_000, Target::Stop);
+    assert!(
+        matches!(r.bank.status(0), DriveStatus::Running { .. }),
+        "{:?}",
+        r.bank.status(0)
+    );
+    let start = r.angle();
+    r.run(600_000, Target::Run(400));
+    assert_eq!(r.power(), PowerState::OperationEnabled);
+    let flexed = r.angle();
+    assert!(flexed > start + 0.2, "flexion: {start} -> {flexed} rad");
+    r.run(600_000, Target::Run(-400));
+    let extended = r.angle();
+    assert!(
+        extended < flexed - 0.2,
+        "extension: {flexed} -> {extended} rad"
+    );
+    // A stop: quick stop, the finger braked where it is.
+    r.run(200_000, Target::Stop);
+    let held = r.angle();
+    r.run(500_000, Target::Stop);
+    assert!(
+        (r.angle() - held).abs() < 1e-3,
+        "braked: {held} -> {}",
+        r.angle()
+    );
+    assert_eq!(r.power(), PowerState::SwitchOnDisabled);
+}
+
+#[test]
+fn velocity_mode_moves_the_finger_at_the_target_speed() {
+    let mut r = Rig::new(Mode::CyclicSyncVelocity);
+    r.run(300_000, Target::Stop);
+    let start = r.angle();
+    // 0.5 rad/s at the joint = 0.5 * 64 * 60 / (2 pi) rpm at the motor.
+    let rpm = (0.5 * 64.0 * 60.0 / std::f64::consts::TAU).round() as i32;
+    r.run(200_000, Target::Run(rpm));
+    let a = r.angle();
+    r.run(400_000, Target::Run(rpm));
+    let speed = (r.angle() - a) / 0.4;
+    assert!(r.angle() > start);
+    assert!((speed - 0.5).abs() < 0.05, "{speed} rad/s");
+}
+
+#[test]
+fn a_tripped_or_power_cycled_drive_reaches_the_master_as_a_fault() {
+    let mut r = Rig::new(Mode::CyclicSyncTorque);
+    r.run(500_000, Target::Run(300));
+    assert!(r.bank.is_enabled(0));
+    r.world
+        .drive_finger_mut(INDEX)
+        .expect("drive")
+        .inject_fault(0x2310);
+    r.run(100_000, Target::Run(300));
+    assert!(
+        matches!(r.bank.status(0), DriveStatus::Faulted(DriveFault::Emcy(e)) if e.code == 0x2310),
+        "{:?}",
+        r.bank.status(0)
+    );
+    let held = r.angle();
+    r.run(300_000, Target::Run(300));
+    assert!(
+        (r.angle() - held).abs() < 1e-3,
+        "a faulted drive does not move"
+    );
+    r.bank.arm();
+    r.run(500_000, Target::Run(300));
+    assert!(r.bank.is_enabled(0), "{:?}", r.bank.status(0));
+    let now = r.now;
+    r.world
+        .drive_finger_mut(INDEX)
+        .expect("drive")
+        .power_cycle(now);
+    r.run(100_000, Target::Run(300));
+    assert_eq!(r.bank.status(0), DriveStatus::Faulted(DriveFault::Rebooted));
+}
