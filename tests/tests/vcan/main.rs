@@ -8,6 +8,7 @@
 
 mod arming;
 mod calibrate;
+mod cia402;
 mod clock_step;
 mod deploy;
 mod deploy_safety;
