@@ -101,6 +101,18 @@ pub enum Fault {
         /// The channel (0..12).
         channel: u8,
     },
+    /// Finger `finger`'s CiA 402 drive trips when the fault starts (EMCY 0x2310, continuous
+    /// over-current, then Fault); it stays in Fault until handd's fault reset.
+    DriveTrip {
+        /// The finger moved by the drive (`handsim --cia402`).
+        finger: usize,
+    },
+    /// Finger `finger`'s CiA 402 drive is power-cycled when the fault starts: its
+    /// configuration is gone and it sends its boot-up message again.
+    DrivePowerCycle {
+        /// The finger moved by the drive.
+        finger: usize,
+    },
     /// The electrode band slipped around the forearm by `tenths` tenths of an electrode
     /// spacing (positive: channel c moves toward c + 1) while the fault is on.
     ElectrodeShift {
@@ -137,6 +149,8 @@ impl Fault {
             }
             | Fault::MotorSilent { finger: f }
             | Fault::SetpointLoss { finger: f }
+            | Fault::DriveTrip { finger: f }
+            | Fault::DrivePowerCycle { finger: f }
                 if f >= N_FINGERS =>
             {
                 Err(SimError::BadFinger(f))
@@ -175,7 +189,7 @@ impl Fault {
         "drop-emg[:N] repeat-emg[:N] reorder-emg[:N] counter-jump[:BY] \
 bad-crc-emg[:N] bad-crc-status[:N] bad-crc-finger:F[:N] lead-off[:MASK] saturation[:MASK] \
 amp-silence estop motor-silent:F setpoint-loss:F unknown-ids[:ID[:COUNT]] flood \
-over-effort[:PCT] electrode-pop[:CH] electrode-shift[:TENTHS]";
+over-effort[:PCT] electrode-pop[:CH] electrode-shift[:TENTHS] drive-trip:F drive-power-cycle:F";
 }
 
 fn num<T: FromStr>(s: Option<&str>, default: T, what: &str) -> Result<T, SimError> {
@@ -243,6 +257,12 @@ impl FromStr for Fault {
                 count: num(b, 100, s)?,
             },
             "flood" => Fault::BusFlood,
+            "drive-trip" => Fault::DriveTrip {
+                finger: num(a, usize::MAX, s)?,
+            },
+            "drive-power-cycle" => Fault::DrivePowerCycle {
+                finger: num(a, usize::MAX, s)?,
+            },
             "over-effort" => Fault::OverEffort {
                 pct: num(a, 250, s)?,
             },

@@ -171,7 +171,8 @@ impl<B: Bus> World<B> {
         let mut drives = Vec::new();
         for (f, listens) in FINGER_LISTENS.iter().enumerate() {
             if let Some(d) = cfg.drives[f] {
-                let node = DriveFingerNode::try_new(f, cfg.finger, d, cfg.start_us)?;
+                let mut node = DriveFingerNode::try_new(f, cfg.finger, d, cfg.start_us)?;
+                node.set_faults(cfg.faults.clone());
                 drives.push((node, open(Listens::Everything)?));
             } else if cfg.nodes.fingers & (1 << f) != 0 {
                 let mut node = FingerNode::try_new(f, cfg.finger, cfg.start_us)?;

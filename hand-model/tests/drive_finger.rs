@@ -29,6 +29,10 @@ struct Rig {
 
 impl Rig {
     fn new(mode: Mode) -> Self {
+        Self::with_faults(mode, FaultPlan::new())
+    }
+
+    fn with_faults(mode: Mode, faults: FaultPlan) -> Self {
         let scaling = ScalingSettings {
             rated_torque_mnm: 25.0,
             gear_ratio: 64.0,
@@ -47,7 +51,7 @@ impl Rig {
         });
         let world = World::try_new(
             WorldConfig {
-                faults: FaultPlan::new(),
+                faults,
                 drives,
                 ..WorldConfig::default()
             },
@@ -206,5 +210,46 @@ fn a_tripped_or_power_cycled_drive_reaches_the_master_as_a_fault() {
         .expect("drive")
         .power_cycle(now);
     r.run(100_000, Target::Run(300));
+    assert_eq!(r.bank.status(0), DriveStatus::Faulted(DriveFault::Rebooted));
+}
+
+#[test]
+fn scheduled_drive_faults_trip_and_power_cycle_the_drive_when_they_start() {
+    let f: hand_model::faults::Fault = "drive-trip:1".parse().expect("parses");
+    assert_eq!(f, hand_model::faults::Fault::DriveTrip { finger: 1 });
+    assert!("drive-power-cycle:5"
+        .parse::<hand_model::faults::Fault>()
+        .is_err());
+    let mut plan = FaultPlan::new();
+    plan.add(
+        hand_model::faults::Fault::DriveTrip { finger: INDEX },
+        700_000,
+        800_000,
+    )
+    .expect("valid");
+    plan.add(
+        hand_model::faults::Fault::DrivePowerCycle { finger: INDEX },
+        1_500_000,
+        1_600_000,
+    )
+    .expect("valid");
+    let mut r = Rig::with_faults(Mode::CyclicSyncTorque, plan);
+    r.run(650_000, Target::Run(300));
+    assert!(r.bank.is_enabled(0), "{:?}", r.bank.status(0));
+    r.run(200_000, Target::Run(300));
+    assert!(
+        matches!(r.bank.status(0), DriveStatus::Faulted(DriveFault::Emcy(e)) if e.code == 0x2310),
+        "{:?}",
+        r.bank.status(0)
+    );
+    assert_eq!(
+        r.power(),
+        PowerState::Fault,
+        "once, not again while the fault lasts"
+    );
+    r.bank.arm();
+    r.run(500_000, Target::Run(300));
+    assert!(r.bank.is_enabled(0), "{:?}", r.bank.status(0));
+    r.run(300_000, Target::Run(300));
     assert_eq!(r.bank.status(0), DriveStatus::Faulted(DriveFault::Rebooted));
 }

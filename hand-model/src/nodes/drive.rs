@@ -21,6 +21,7 @@ use hand_canopen::{NodeId, ObjectAddr};
 use super::{std_id, Bus, NodeStats};
 use crate::dbc::CanFrame;
 use crate::error::SimError;
+use crate::faults::{Fault, FaultPlan};
 use crate::finger::{Command, FingerConfig, FingerMode, FingerPhysics, N_FINGERS};
 
 /// The position actual value's unit: increments per radian of joint angle.
@@ -57,6 +58,9 @@ pub struct DriveFingerNode {
     last_step_us: u64,
     out: Vec<hand_canopen::CanFrame>,
     stats: NodeStats,
+    faults: FaultPlan,
+    /// One-shot faults already applied (bit i = the plan's fault i).
+    one_shots: u64,
 }
 
 impl DriveFingerNode {
@@ -84,6 +88,8 @@ impl DriveFingerNode {
             last_step_us: start_us,
             out,
             stats: NodeStats::default(),
+            faults: FaultPlan::new(),
+            one_shots: 0,
         })
     }
 
@@ -110,6 +116,31 @@ impl DriveFingerNode {
     /// Power-cycles the drive at `now_us`: its configuration is gone, it boots again.
     pub fn power_cycle(&mut self, now_us: u64) {
         self.drive.power_on(now_us, &mut self.out);
+    }
+
+    /// The faults of the run: `drive-trip:F` and `drive-power-cycle:F` of this finger act on
+    /// the drive when they start.
+    pub fn set_faults(&mut self, faults: FaultPlan) {
+        self.faults = faults;
+    }
+
+    fn apply_faults(&mut self, now_us: u64) {
+        let mine: Vec<(usize, Fault)> = self
+            .faults
+            .active(now_us)
+            .filter(|&(i, f)| {
+                self.one_shots & (1 << i) == 0
+                    && matches!(f, Fault::DriveTrip { finger } | Fault::DrivePowerCycle { finger }
+                        if finger == self.finger)
+            })
+            .collect();
+        for (i, f) in mine {
+            self.one_shots |= 1 << i;
+            match f {
+                Fault::DriveTrip { .. } => self.inject_fault(0x2310),
+                _ => self.power_cycle(now_us),
+            }
+        }
     }
 
     /// Transmit and receive counts.
@@ -149,6 +180,7 @@ impl DriveFingerNode {
 
     /// Reads what arrived, runs the drive and the finger to `now_us`, sends what is due.
     pub fn poll<B: Bus>(&mut self, now_us: u64, bus: &mut B) {
+        self.apply_faults(now_us);
         while let Some(frame) = self.stats.receive(bus) {
             let id = std_id(&frame);
             if let Some(f) = u16::try_from(id)

@@ -1,8 +1,10 @@
 //! Issue 26 over SocketCAN: the index finger through a simulated CiA 402 drive (`handsim
 //! --cia402 1`, node 6) while the other fingers stay native. handd starts the drive over the
 //! bus (reset, boot-up, identity, configuration read back, the power state machine), then every
-//! tick sends its RPDO1 followed by SYNC; the drive's TPDO1 comes back. Killed, handd stops
-//! its heartbeat and the drive stops by itself on its watchdog (EMCY 0x8130).
+//! tick sends its RPDO1 followed by SYNC; the drive's TPDO1 comes back. The drive trips (EMCY):
+//! that finger alone gets the quick stop until `handctl arm`, which starts the drive again.
+//! Killed, handd stops its heartbeat and the drive stops by itself on its watchdog (EMCY
+//! 0x8130).
 
 use std::time::{Duration, Instant};
 
@@ -11,6 +13,7 @@ use handstack_tests::vcan::monitor::now_us;
 use handstack_tests::vcan::procs::handsim;
 use handstack_tests::vcan::{Monitor, TestConfig, VcanEnv};
 
+use super::arming::Armed;
 use super::calibrated_model;
 
 /// The index finger's drive, as `handsim --cia402 1` simulates it.
@@ -25,6 +28,34 @@ const SYNC: u32 = 0x07F;
 /// The drive watches handd's heartbeat for three ticks (150 ms); its heartbeat came at most one
 /// tick before the kill, and the EMCY needs a frame time: 250 ms is the bar.
 const WATCHDOG_BAR_US: u64 = 250_000;
+/// The drive trips this long after handsim started, s.
+const TRIP_S: f64 = 3.0;
+
+/// Polls `handctl status` until the index drive's line satisfies `ok` (and handd runs, if
+/// `running`), for at most `limit`; the time it took.
+fn wait_drive(
+    env: &VcanEnv,
+    cfg: &TestConfig,
+    what: &str,
+    limit: Duration,
+    ok: impl Fn(&driver::protocol::DriveLine) -> bool,
+) -> Duration {
+    let started = Instant::now();
+    loop {
+        let st = cfg.status(env);
+        if st.state == "RUNNING" && st.drives.first().is_some_and(&ok) {
+            return started.elapsed();
+        }
+        assert!(
+            started.elapsed() < limit,
+            "{what}: not within {limit:?}: state {}, faults {}, drives {:?}",
+            st.state,
+            st.faults,
+            st.drives
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
 
 #[test]
 fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
@@ -37,32 +68,55 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
     std::fs::write(&cfg.path, text).expect("write the config");
     let monitor = Monitor::start(&env.iface);
     let mut handd = cfg.start(&env, &dir);
-    let mut sim = handsim(&env, &dir, "handsim", "sine", 6.0, &["--cia402", "1"]);
-    let started = Instant::now();
-    let following = loop {
-        let st = cfg.status(&env);
-        let drive = st.drives.first().cloned();
-        if st.state == "RUNNING"
-            && drive
-                .as_ref()
-                .is_some_and(|d| d.state.starts_with("Operation enabled, following"))
-        {
-            break started.elapsed();
-        }
-        assert!(
-            started.elapsed() < Duration::from_secs(4),
-            "the index drive never followed its setpoint: state {}, faults {}, drives {:?}\n\
-             handd:\n{}",
-            st.state,
-            st.faults,
-            st.drives,
-            handd.output()
-        );
-        std::thread::sleep(Duration::from_millis(100));
-    };
+    let trip = format!("drive-trip:1@{TRIP_S}..{}", TRIP_S + 0.1);
+    let mut sim = handsim(
+        &env,
+        &dir,
+        "handsim",
+        "sine",
+        10.0,
+        &["--cia402", "1", "--fault", &trip],
+    );
+    let sim_at = now_us();
+    let following =
+        |d: &driver::protocol::DriveLine| d.state.starts_with("Operation enabled, following");
+    let t = wait_drive(
+        &env,
+        &cfg,
+        "the index drive follows",
+        Duration::from_secs(4),
+        following,
+    );
     println!(
         "cia402: the index drive follows its setpoint {:.0} ms after handsim started",
-        following.as_secs_f64() * 1e3
+        t.as_secs_f64() * 1e3
+    );
+    // The trip: that finger stopped with the drive's EMCY named, the hand still RUNNING.
+    wait_drive(
+        &env,
+        &cfg,
+        "the trip is seen",
+        Duration::from_secs(5),
+        |d| d.faulted && d.state.contains("EMCY") && d.state.contains("0x2310"),
+    );
+    let tripped_at = now_us();
+    println!(
+        "cia402: status shows the drive's trip {:.0} ms after handsim's {TRIP_S} s",
+        (tripped_at - sim_at) as f64 * 1e-3 - TRIP_S * 1e3
+    );
+    std::thread::sleep(Duration::from_millis(500));
+    let armed = Armed::now(&env, &cfg.socket);
+    let t = wait_drive(
+        &env,
+        &cfg,
+        "the drive runs again after arm",
+        Duration::from_secs(4),
+        following,
+    );
+    println!(
+        "cia402: after `handctl arm` ({:.0} ms to answer) the drive follows again {:.0} ms later",
+        (armed.answered_us - armed.sent_us) as f64 * 1e-3,
+        t.as_secs_f64() * 1e3
     );
     std::thread::sleep(Duration::from_millis(1_000));
     let kill_at = now_us();
@@ -103,6 +157,16 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
             r.0
         );
     }
+    // Between the trip (seen by status) and the arm: the quick stop, target zero, each tick.
+    let stopped: Vec<_> = frames
+        .iter()
+        .filter(|f| f.1 == RPDO1 && f.0 > tripped_at && f.0 < armed.sent_us)
+        .collect();
+    assert!(stopped.len() >= 8, "{} RPDO1 while tripped", stopped.len());
+    assert!(
+        stopped.iter().all(|f| f.2 == [0x02, 0x00, 0x00, 0x00]),
+        "quick stop with the target zeroed while tripped: {stopped:?}"
+    );
     let tpdos = last_second(TPDO1);
     assert!(tpdos.len() >= 17, "{} TPDO1 in that second", tpdos.len());
     // No FINGER_SETPOINT for the index finger; the thumb's still come.
