@@ -165,7 +165,7 @@ fn with_a_cia402_drive(frames: &[(u64, CanFrame)]) {
         // after they were sent), then the recorded traffic up to now.
         let mut from_drive = Vec::new();
         let mut to_drive: Vec<CanFrame> = Vec::new();
-        let mut feed = |engine: &mut Engine, f: &CanFrame, at: u64, out: &mut Vec<CanFrame>| {
+        let feed = |engine: &mut Engine, f: &CanFrame, at: u64, out: &mut Vec<CanFrame>| {
             // The engine's calls only: copying its frames out is the test's own allocation.
             let before = GLOBAL.stats();
             engine.on_frame(f, at);
