@@ -25,6 +25,7 @@ use hand_dbc::CanFrame;
 use crate::bus_load::BusLoad;
 use crate::conditioner::{FingerGains, Setpoint};
 use crate::engine::{AmpProblem, Command, Counters, Engine};
+use crate::protocol::{LateTick, LATE_TICKS_KEPT};
 use crate::safety::{DaemonState, Fault, FaultSet, FingerEvent};
 use crate::stats::Percentiles;
 use crate::transport::{BusHealth, ControllerState, Transport, TransportError};
@@ -95,6 +96,19 @@ pub struct Snapshot {
     pub bus: BusHealth,
     /// Each CiA 402 finger's drive: its node id and status (`None`: a native finger).
     pub drives: [Option<(u8, hand_canopen::DriveStatus)>; N_FINGERS],
+    /// The last late ticks (a ring: entry `i % LATE_TICKS_KEPT` is the i-th late tick).
+    pub late: [LateTick; LATE_TICKS_KEPT],
+    /// Late ticks since start.
+    pub late_count: u64,
+}
+
+impl Snapshot {
+    /// The late ticks the ring holds, oldest first.
+    pub fn late_ticks(&self) -> impl Iterator<Item = LateTick> + '_ {
+        let kept = self.late_count.min(LATE_TICKS_KEPT as u64);
+        (self.late_count - kept..self.late_count)
+            .map(|i| self.late[(i % LATE_TICKS_KEPT as u64) as usize])
+    }
 }
 
 impl Default for Snapshot {
@@ -127,6 +141,8 @@ impl Default for Snapshot {
             publish_skips: 0,
             bus: BusHealth::default(),
             drives: [None; N_FINGERS],
+            late: [LateTick::default(); LATE_TICKS_KEPT],
+            late_count: 0,
         }
     }
 }
@@ -230,6 +246,10 @@ pub struct Runner<T: Transport, K: Clock> {
     rms_history: [[f64; SNAPSHOT_CHANNELS]; RMS_HISTORY],
     /// Ticks written into `rms_history` (its next slot is this modulo [`RMS_HISTORY`]).
     rms_ticks: usize,
+    /// The last late ticks ([`Snapshot::late`]) and how many there were.
+    late: [LateTick; LATE_TICKS_KEPT],
+    late_count: u64,
+    late_log: LogLimit,
 }
 
 impl<T: Transport, K: Clock> Runner<T, K> {
@@ -266,6 +286,9 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             amp_problem: None,
             latches: None,
             never_opened: false,
+            late: [LateTick::default(); LATE_TICKS_KEPT],
+            late_count: 0,
+            late_log: LogLimit::default(),
         }
     }
 
@@ -577,11 +600,15 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         let now = self.clock.now_us();
         self.skip_missed_deadlines(now);
         let deadline = self.next_deadline_us;
+        let frames_before = self.frames_rx;
         self.try_reopen(now);
         self.drain(deadline);
         self.apply_commands(deadline);
         let t0 = self.clock.now_us();
         self.last_tick_on_time = self.engine.on_time(t0, deadline);
+        if !self.last_tick_on_time {
+            self.note_late(deadline, now, t0, self.frames_rx - frames_before);
+        }
         // Error-passive: a transient fault while it lasts (the safe stops of this tick
         // already go out in SAFE).
         if self.bus_ok && self.transport.health().state == ControllerState::ErrorPassive {
@@ -635,6 +662,33 @@ impl<T: Transport, K: Clock> Runner<T, K> {
         }
         // A tick that ran past the next deadline: the next step skips what it missed.
         self.next_deadline_us += self.tick_us;
+    }
+
+    /// Keeps where a late tick's time went (woken at `woke`, started at `started`, daemon
+    /// clock), logged at most once per [`BUS_LOG_EVERY_US`] with the count left out.
+    #[cold]
+    fn note_late(&mut self, deadline: u64, woke: u64, started: u64, frames: u64) {
+        let since_deadline = self.clock.now_us().saturating_sub(deadline);
+        let late = LateTick {
+            deadline_mono_us: crate::rt::monotonic_us().saturating_sub(since_deadline),
+            wake_us: woke.saturating_sub(deadline),
+            read_us: started.saturating_sub(woke.max(deadline)),
+            frames,
+            cpu: crate::rt::current_cpu(),
+        };
+        self.late[(self.late_count % LATE_TICKS_KEPT as u64) as usize] = late;
+        self.late_count += 1;
+        if let Some(left_out) = self.late_log.allow(started) {
+            tracing::warn!(
+                late_us = late.lateness_us(),
+                woke_us = late.wake_us,
+                read_us = late.read_us,
+                frames,
+                cpu = late.cpu,
+                left_out,
+                "tick started late: woke after its deadline, then read the bus"
+            );
+        }
     }
 
     /// Names a change of what the amplifier's status says (logged once per change, not per
@@ -710,6 +764,8 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             publish_skips: self.publish_skips,
             bus: self.bus_health(),
             drives: std::array::from_fn(|f| e.drive(f)),
+            late: self.late,
+            late_count: self.late_count,
         };
         match self.snapshot.try_lock() {
             Ok(mut s) => *s = snap,

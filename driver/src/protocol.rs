@@ -148,6 +148,38 @@ pub struct Status {
     /// than this field).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub drives: Vec<DriveLine>,
+    /// The last ticks that started later than the deadline slack, oldest first (at most
+    /// [`LATE_TICKS_KEPT`]; none on time, and from a daemon older than this field).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub late_ticks: Vec<LateTick>,
+}
+
+/// Late ticks a status keeps.
+pub const LATE_TICKS_KEPT: usize = 8;
+
+/// A tick that started later than the deadline slack, and where its time went: the loop
+/// waking up after the deadline (the scheduler, or a machine that did not run), then the bus
+/// read and the commands before the tick's own work.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+pub struct LateTick {
+    /// The tick's deadline on the machine's CLOCK_MONOTONIC, µs (to line it up with what
+    /// other processes on the machine saw at that time).
+    pub deadline_mono_us: u64,
+    /// From the deadline to the loop awake, µs.
+    pub wake_us: u64,
+    /// The bus read and the commands after waking, µs.
+    pub read_us: u64,
+    /// Frames that read took in.
+    pub frames: u64,
+    /// The CPU the loop ran the tick on.
+    pub cpu: u32,
+}
+
+impl LateTick {
+    /// How late the tick started, µs.
+    pub fn lateness_us(&self) -> u64 {
+        self.wake_us + self.read_us
+    }
 }
 
 /// One CiA 402 finger's drive as `handctl status` shows it.

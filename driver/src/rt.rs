@@ -56,6 +56,19 @@ pub fn set_fifo(priority: u8, report: &mut RtReport) {
     }
 }
 
+/// The machine's CLOCK_MONOTONIC, µs: the one time base of every process on the machine,
+/// to line up what the daemon saw with what others saw (the daemon's own clock counts from
+/// its start).
+pub fn monotonic_us() -> u64 {
+    let t = rustix::time::clock_gettime(rustix::time::ClockId::Monotonic);
+    t.tv_sec as u64 * 1_000_000 + t.tv_nsec as u64 / 1_000
+}
+
+/// The CPU the calling thread runs on.
+pub fn current_cpu() -> u32 {
+    rustix::thread::sched_getcpu() as u32
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -173,6 +173,7 @@ impl ControlHandler {
                     Some(crate::protocol::DriveLine::of(FINGER_NAMES[f], node, &st))
                 })
                 .collect(),
+            late_ticks: s.late_ticks().collect(),
         }
     }
 

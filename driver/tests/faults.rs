@@ -337,4 +337,20 @@ fn a_late_tick_that_lost_nothing_keeps_the_hand_running() {
         r.runner.engine().faults()
     );
     assert_eq!(r.runner.engine().state(), DaemonState::Running);
+    // Where its time went, kept for `handctl status`: all of it the wake-up (the virtual
+    // clock stands still while the tick reads the 80 ms the bus queued).
+    let snap = *r.runner.snapshot().lock().unwrap();
+    let late: Vec<_> = snap.late_ticks().collect();
+    assert_eq!(late.len() as u64, snap.counters.deadline_misses, "{late:?}");
+    assert_eq!(late.len(), 1, "{late:?}");
+    let slack = driver::engine::EngineSettings::default().deadline_slack_us;
+    assert!(
+        late[0].wake_us > slack && late[0].wake_us <= 50_000 && late[0].read_us == 0,
+        "{late:?}"
+    );
+    assert!(
+        late[0].frames > 20,
+        "the read took in {} frames",
+        late[0].frames
+    );
 }

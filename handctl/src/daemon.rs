@@ -153,6 +153,21 @@ pub fn format_status(s: &Status) -> String {
             );
         }
     }
+    if !s.late_ticks.is_empty() {
+        out += "\nlast late ticks (woke after the deadline + read the bus before starting)\n";
+        for l in &s.late_ticks {
+            out += &format!(
+                "  {:>6} us late = woke {:>6} us + read {:>5} us ({} frames), CPU {}, at \
+                 CLOCK_MONOTONIC {:.3} s\n",
+                l.lateness_us(),
+                l.wake_us,
+                l.read_us,
+                l.frames,
+                l.cpu,
+                l.deadline_mono_us as f64 / 1e6
+            );
+        }
+    }
     out
 }
 
@@ -305,5 +320,30 @@ mod tests {
         assert!(!format_status(&Status::default()).contains("CiA 402"));
         let json = serde_json::to_value(Status::default()).unwrap();
         assert!(json.get("drives").is_none());
+    }
+
+    #[test]
+    fn status_says_where_each_late_ticks_time_went() {
+        let s = Status {
+            late_ticks: vec![driver::protocol::LateTick {
+                deadline_mono_us: 224_400_123,
+                wake_us: 27_000,
+                read_us: 1_500,
+                frames: 96,
+                cpu: 1,
+            }],
+            ..Status::default()
+        };
+        let text = format_status(&s);
+        assert!(
+            text.contains(
+                "\n   28500 us late = woke  27000 us + read  1500 us (96 frames), CPU 1, at \
+                 CLOCK_MONOTONIC 224.400 s\n"
+            ),
+            "{text}"
+        );
+        assert!(!format_status(&Status::default()).contains("late ticks"));
+        let json = serde_json::to_value(Status::default()).unwrap();
+        assert!(json.get("late_ticks").is_none());
     }
 }
