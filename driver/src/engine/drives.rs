@@ -16,8 +16,16 @@ use crate::units::N_FINGERS;
 /// dropped and counted (a start-up step then times out and names itself).
 pub const MAX_IMMEDIATE: usize = 16;
 
+/// How long a drive may take to answer one SDO request during start-up, µs: python
+/// `canopen`'s `SdoClient.RESPONSE_TIMEOUT` (0.3 s). The request goes out when handd has read
+/// the previous answer (it reads the bus every 10 ms between ticks), and a drive may be busy
+/// (saving, resetting); 50 ms timed out in the vcan suite, whose guest CPUs stop for up to 32 ms
+/// under emulation. Start-up holds the finger disabled, so a longer wait costs only time.
+pub const SDO_TIMEOUT_US: u64 = 300_000;
+
 /// handd's side of the CANopen timing, from the tick: the drives watch handd's heartbeat for
-/// three ticks, send their own every tick, and handd gives them three ticks too.
+/// three ticks, send their own every tick, and handd gives them three ticks too. An SDO reply
+/// may take [`SDO_TIMEOUT_US`].
 pub fn bank_settings(master: NodeId, sync: CobId, tick_us: u64) -> BankSettings {
     let tick_ms = (tick_us / 1000).clamp(1, u64::from(u16::MAX) / 3) as u16;
     BankSettings {
@@ -27,7 +35,7 @@ pub fn bank_settings(master: NodeId, sync: CobId, tick_us: u64) -> BankSettings 
         master_heartbeat_timeout_ms: 3 * tick_ms,
         drive_heartbeat_ms: tick_ms,
         drive_heartbeat_timeout_us: 3 * u64::from(tick_ms) * 1000,
-        sdo_timeout_us: 50_000,
+        sdo_timeout_us: SDO_TIMEOUT_US,
         step_timeout_us: 1_000_000,
     }
 }

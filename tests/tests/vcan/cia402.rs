@@ -3,7 +3,8 @@
 //! bus (reset, boot-up, identity, configuration read back, the power state machine), then every
 //! tick sends its RPDO1 followed by SYNC; the drive's TPDO1 comes back. The drive trips (EMCY):
 //! that finger alone gets the quick stop until `handctl arm`, which starts the drive again.
-//! Killed, handd stops its heartbeat and the drive stops by itself on its watchdog (EMCY
+//! The drive is power-cycled: handd sees its boot-up, holds it in quick stop, never enables it
+//! before `handctl arm`, and after the arm configures it from scratch. Killed, handd stops its heartbeat and the drive stops by itself on its watchdog (EMCY
 //! 0x8130).
 
 use std::time::{Duration, Instant};
@@ -25,11 +26,15 @@ const RPDO1: u32 = 0x206;
 const TPDO1: u32 = 0x186;
 const EMCY: u32 = 0x086;
 const SYNC: u32 = 0x07F;
+/// SDO requests to the drive.
+const SDO_RX: u32 = 0x606;
 /// The drive watches handd's heartbeat for three ticks (150 ms); its heartbeat came at most one
 /// tick before the kill, and the EMCY needs a frame time: 250 ms is the bar.
 const WATCHDOG_BAR_US: u64 = 250_000;
 /// The drive trips this long after handsim started, s.
 const TRIP_S: f64 = 3.0;
+/// The drive is power-cycled this long after handsim started, s.
+const POWER_CYCLE_S: f64 = 6.5;
 
 /// Polls `handctl status` until the index drive's line satisfies `ok` (and handd runs, if
 /// `running`), for at most `limit`; the time it took.
@@ -69,13 +74,17 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
     let monitor = Monitor::start(&env.iface);
     let mut handd = cfg.start(&env, &dir);
     let trip = format!("drive-trip:1@{TRIP_S}..{}", TRIP_S + 0.1);
+    let cycle = format!(
+        "drive-power-cycle:1@{POWER_CYCLE_S}..{}",
+        POWER_CYCLE_S + 0.1
+    );
     let mut sim = handsim(
         &env,
         &dir,
         "handsim",
         "sine",
-        10.0,
-        &["--cia402", "1", "--fault", &trip],
+        14.0,
+        &["--cia402", "1", "--fault", &trip, "--fault", &cycle],
     );
     let sim_at = now_us();
     let following =
@@ -116,6 +125,32 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
     println!(
         "cia402: after `handctl arm` ({:.0} ms to answer) the drive follows again {:.0} ms later",
         (armed.answered_us - armed.sent_us) as f64 * 1e-3,
+        t.as_secs_f64() * 1e3
+    );
+    // The power cycle: its boot-up seen, the finger held until `arm`, then started again.
+    wait_drive(
+        &env,
+        &cfg,
+        "the power cycle is seen",
+        Duration::from_secs(6),
+        |d| d.faulted && d.state.contains("booted"),
+    );
+    let booted_at = now_us();
+    println!(
+        "cia402: status shows the drive's power cycle {:.0} ms after handsim's {POWER_CYCLE_S} s",
+        (booted_at - sim_at) as f64 * 1e-3 - POWER_CYCLE_S * 1e3
+    );
+    std::thread::sleep(Duration::from_millis(500));
+    let rearmed = Armed::now(&env, &cfg.socket);
+    let t = wait_drive(
+        &env,
+        &cfg,
+        "the drive runs again after the power cycle and arm",
+        Duration::from_secs(4),
+        following,
+    );
+    println!(
+        "cia402: after the power cycle and `handctl arm` the drive follows again {:.0} ms later",
         t.as_secs_f64() * 1e3
     );
     std::thread::sleep(Duration::from_millis(1_000));
@@ -166,6 +201,37 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
     assert!(
         stopped.iter().all(|f| f.2 == [0x02, 0x00, 0x00, 0x00]),
         "quick stop with the target zeroed while tripped: {stopped:?}"
+    );
+    // Between the power cycle (seen by status) and the second arm: the quick stop each tick,
+    // never Enable operation, and the drive configured again only after the arm (its SDO
+    // requests, 0x606, come after it).
+    let held: Vec<_> = frames
+        .iter()
+        .filter(|f| f.1 == RPDO1 && f.0 > booted_at && f.0 < rearmed.sent_us)
+        .collect();
+    assert!(
+        held.len() >= 8,
+        "{} RPDO1 after the power cycle",
+        held.len()
+    );
+    assert!(
+        held.iter().all(|f| f.2 == [0x02, 0x00, 0x00, 0x00]),
+        "quick stop with the target zeroed after the power cycle: {held:?}"
+    );
+    let sdo_after = |from: u64, to: u64| {
+        frames
+            .iter()
+            .filter(|f| f.1 == SDO_RX && f.0 > from && f.0 < to)
+            .count()
+    };
+    assert_eq!(
+        sdo_after(booted_at, rearmed.sent_us),
+        0,
+        "handd configured the power-cycled drive before `arm`"
+    );
+    assert!(
+        sdo_after(rearmed.sent_us, kill_at) >= 20,
+        "the power-cycled drive was not configured again after `arm`"
     );
     let tpdos = last_second(TPDO1);
     assert!(tpdos.len() >= 17, "{} TPDO1 in that second", tpdos.len());
