@@ -28,6 +28,8 @@ const EMCY: u32 = 0x086;
 const SYNC: u32 = 0x07F;
 /// SDO requests to the drive.
 const SDO_RX: u32 = 0x606;
+/// The drive's heartbeat and boot-up (`00`).
+const BOOT_UP: u32 = 0x706;
 /// The drive watches handd's heartbeat for three ticks (150 ms); its heartbeat came at most one
 /// tick before the kill, and the EMCY needs a frame time: 250 ms is the bar.
 const WATCHDOG_BAR_US: u64 = 250_000;
@@ -217,6 +219,29 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
     assert!(
         held.iter().all(|f| f.2 == [0x02, 0x00, 0x00, 0x00]),
         "quick stop with the target zeroed after the power cycle: {held:?}"
+    );
+    // From the drive's boot-up on the bus to handd's first RPDO1 after it: the quick stop,
+    // within the 100 ms every other drill gives a safe stop.
+    let boot_up = frames
+        .iter()
+        .rev()
+        .find(|f| f.1 == BOOT_UP && f.2 == [0x00] && f.0 < booted_at)
+        .expect("the power-cycled drive's boot-up on the bus");
+    let first = frames
+        .iter()
+        .find(|f| f.1 == RPDO1 && f.0 > boot_up.0)
+        .expect("an RPDO1 after the boot-up");
+    println!(
+        "cia402: handd's first RPDO1 after the power-cycled drive's boot-up: {:.1} ms later, \
+         {:02X?}",
+        (first.0 - boot_up.0) as f64 * 1e-3,
+        first.2
+    );
+    assert_eq!(first.2, [0x02, 0x00, 0x00, 0x00], "not the quick stop");
+    assert!(
+        first.0 - boot_up.0 <= 100_000,
+        "the quick stop {} us after the boot-up",
+        first.0 - boot_up.0
     );
     let sdo_after = |from: u64, to: u64| {
         frames
