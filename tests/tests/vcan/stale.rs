@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 
 use hand_dbc::messages::{FingerMode, FingerSetpoint, FingerState};
 use hand_model::dbc::seal;
-use handstack_tests::vcan::monitor::{now_us, writer};
+use handstack_tests::vcan::monitor::{now_us, reader_of, writer};
 use handstack_tests::vcan::Seen;
 use socketcan::{CanSocket, EmbeddedFrame, Frame, Socket};
 
@@ -71,16 +71,20 @@ fn until_last_round(
     mut active: FingerSetpoint,
 ) -> (FingerSetpoint, FingerSetpoint) {
     let begun = Instant::now();
+    let mut read = 0;
     loop {
         assert!(
             begun.elapsed() < Duration::from_secs(3),
-            "handd sent no last round for finger {FINGER} within 3 s of SIGTERM"
+            "handd sent no last round for finger {FINGER} within 3 s of SIGTERM \
+             ({read} ACTIVE setpoints read after it, the last with counter {})",
+            active.counter()
         );
         let Some(sp) = reader.read_frame().ok().as_ref().and_then(finger_setpoint) else {
             continue;
         };
         if sp.mode() == FingerMode::Active {
             active = sp;
+            read += 1;
             continue;
         }
         return (active, sp);
@@ -116,10 +120,13 @@ fn stale_active_setpoint_before_the_next_epochs_safe_stop_after_sigterm_moves_no
     let mut rig = Rig::start("stale", DRILL_SILENCE_MS);
     let mut sim = rig.sim("sine", RUN_S, &[]);
     let w = writer(&rig.env.iface);
-    let reader = CanSocket::open(&rig.env.iface).expect("a reader socket");
-    reader
-        .set_read_timeout(Duration::from_millis(100))
-        .expect("read timeout");
+    // Only FINGER's setpoints: the last round is one frame, and a reader that queued the
+    // amplifier too could have dropped it while the test waited or spawned `kill`.
+    let reader = reader_of(
+        &rig.env.iface,
+        &[FingerSetpoint::IDS[FINGER]],
+        Duration::from_millis(100),
+    );
     let start = wait_scenario_start(&rig.monitor);
     while now_us() < start + ONSET_US {
         std::thread::sleep(Duration::from_millis(1));
