@@ -21,6 +21,7 @@ pub mod live;
 pub mod mem_transport;
 pub mod model_service;
 pub mod persist;
+pub mod planned_load;
 pub mod protocol;
 pub mod rest_check;
 pub mod rt;

@@ -332,10 +332,14 @@ fn print_check(args: &Args, config: &Config, loaded: Option<&LoadedModel>) {
         );
     }
     if let Ok(drives) = config.drives() {
+        println!(
+            "{}",
+            driver::planned_load::planned_load(&drives, config.tick_ms * 1000)
+        );
         for (name, d) in driver::units::FINGER_NAMES.iter().zip(drives.fingers) {
             if let driver::drive_config::Drive::Cia402 { node, mode, .. } = d {
                 println!(
-                    "finger {name}: CiA 402 drive, node {node}, mode {} (started, configured \
+                    "finger {name}: CiA 402 drive, {node}, mode {} (started, configured \
                      and enabled by handd at start)",
                     mode.value()
                 );
