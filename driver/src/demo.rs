@@ -9,6 +9,12 @@
 //!
 //! The calibration is always simulated faster than real time (it is a recording); the
 //! tracking runs on the system clock in real time, or on a virtual clock with `fast`.
+//!
+//! With [`DriveProfile::Cia402`] every finger of the tracking phase is moved by a simulated
+//! CiA 402 drive (`hand_model::nodes::DriveFingerNode`, node 5 + finger, cyclic synchronous
+//! torque) that handd starts over the bus and drives as a handd.toml with
+//! `[fingers.NAME.drive] profile = "cia402"` asks; the patient then feels the index finger's
+//! force from the finger itself (a drive sends no FINGER_STATUS), and the score reads it there.
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -26,14 +32,16 @@ use hand_dbc::candump::LogWriter;
 use hand_dbc::messages::{FingerSetpoint, FingerStatus};
 use hand_dbc::CanFrame;
 use hand_model::emg::AmplifierConfig;
-use hand_model::nodes::AmplifierNodeConfig;
+use hand_model::nodes::drive::simulated_node_id;
+use hand_model::nodes::{AmplifierNodeConfig, DriveFingerConfig};
 use hand_model::patient::TrackingConfig;
 use hand_model::record::run_on_mem_bus;
 use hand_model::world::{PatientMode, World, WorldConfig};
 use hand_model::{MemBus, MemEndpoint, Scenario};
 
-use crate::config::Config;
+use crate::config::{Config, ConfigError};
 use crate::daemon::{Runner, Snapshot};
+use crate::drive_config::{DriveConfig, DriveMode, Profile};
 use crate::engine::{Command, Engine};
 use crate::mem_transport::MemTransport;
 use crate::startup::engine_settings;
@@ -60,6 +68,54 @@ pub struct DemoOptions {
     pub mask_others: bool,
     /// The output law of the tracking phase: the shipped one, or the paper's pure integrator.
     pub law: OutputLaw,
+    /// What moves the fingers in the tracking phase.
+    pub drives: DriveProfile,
+}
+
+/// What moves the demo's fingers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DriveProfile {
+    /// hand.dbc's native finger controllers (FINGER_SETPOINT, FINGER_STATUS).
+    #[default]
+    Native,
+    /// A simulated CiA 402 drive per finger, started and driven by handd over CANopen.
+    Cia402,
+}
+
+impl DriveProfile {
+    /// The daemon's configuration for this profile: the defaults, and for CiA 402 each
+    /// finger's `[fingers.NAME.drive]` table as a technician would write it for the simulated
+    /// drives (node 5 + finger, cyclic synchronous torque, their scaling).
+    pub fn config(self) -> Config {
+        let mut config = Config::default();
+        if self == Self::Cia402 {
+            let s = DriveFingerConfig::SIM_SCALING;
+            for f in 0..N_FINGERS {
+                config.fingers.get_mut(f).drive = DriveConfig {
+                    profile: Profile::Cia402,
+                    node_id: Some(simulated_node_id(f)),
+                    mode: Some(DriveMode::Cst),
+                    rated_torque_mnm: Some(s.rated_torque_mnm),
+                    gear_ratio: Some(s.gear_ratio),
+                    moment_arm_m: Some(s.moment_arm_m),
+                    max_torque_permille: Some(s.max_torque_permille),
+                    max_speed_rpm: Some(s.max_speed_rpm),
+                };
+            }
+        }
+        config
+    }
+
+    /// The simulated world's drives for this profile.
+    fn world_drives(self) -> Result<[Option<DriveFingerConfig>; N_FINGERS], DemoError> {
+        let mut out = [None; N_FINGERS];
+        if self == Self::Cia402 {
+            for (f, slot) in out.iter_mut().enumerate() {
+                *slot = Some(DriveFingerConfig::simulated(f)?);
+            }
+        }
+        Ok(out)
+    }
 }
 
 /// Which velocity law the tracking phase's conditioners run.
@@ -84,6 +140,7 @@ impl Default for DemoOptions {
             plain: false,
             mask_others: false,
             law: OutputLaw::Shipped,
+            drives: DriveProfile::Native,
         }
     }
 }
@@ -103,7 +160,15 @@ pub struct DemoReport {
     pub train_ms: u64,
     /// The verification of the model's calibration rays, as its file records it.
     pub verification: VerificationRecord,
-    /// Scored samples (FINGER_STATUS of the index finger, 50 Hz).
+    /// The tracking phase.
+    pub tracking: TrackingReport,
+}
+
+/// What the tracking phase measured.
+#[derive(Debug, Clone)]
+pub struct TrackingReport {
+    /// Scored samples (the index finger's force at 50 Hz: its FINGER_STATUS, or read off the
+    /// finger when a CiA 402 drive moves it).
     pub samples: usize,
     /// Root mean square error of force/full-scale against the target.
     pub rmse: f64,
@@ -117,7 +182,7 @@ pub struct DemoReport {
     pub mean_abs_label: [f64; N_FINGERS],
     /// Per finger, the mean |velocity setpoint| handd sent over the scored time, rad/s: what
     /// the output law makes of the labels (the fingers the patient does not move should stay
-    /// near 0).
+    /// near 0). For a finger on a CiA 402 drive (torque mode), the joint's mean |velocity|.
     pub mean_abs_velocity: [f64; N_FINGERS],
     /// Per finger, the time its controller reported being at a joint stop with the command
     /// pushing into it (FINGER_STATUS fault bit 5) over the scored time, s.
@@ -125,6 +190,8 @@ pub struct DemoReport {
     /// Per finger, the entries into a joint stop over the whole tracking (the simulated
     /// controller counts them) and the fastest, rad/s.
     pub impacts: [(u64, f64); N_FINGERS],
+    /// The CiA 402 drives ([`DriveProfile::Cia402`]).
+    pub drives: DrivesRecord,
     /// The daemon's snapshot at the end (latency, deadline misses, ...).
     pub end: Snapshot,
 }
@@ -188,6 +255,9 @@ pub enum DemoError {
     /// Scoring.
     #[error("scoring: {0}")]
     Eval(#[from] decoder::eval::EvalError),
+    /// The daemon's configuration for the chosen drives is refused.
+    #[error("the demo's configuration: {0}")]
+    Config(#[from] ConfigError),
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> DemoError + '_ {
@@ -286,13 +356,47 @@ pub fn run_demo(
     let model_path = opts.work_dir.join("model.hsm");
     model.save(&model_path)?;
 
-    on(DemoEvent::Phase(
-        "tracking: the daemon drives the hand, the patient follows a sine with the index finger",
-    ));
-    let (Tracked { samples, motion }, end) = if opts.fast {
-        track(&model, opts, VirtualClock::new(), true, &mut on)?
+    let tracking = track_model(&model, opts, &mut on)?;
+    let s = model.summary();
+    Ok(DemoReport {
+        session_dir,
+        model_path,
+        trials,
+        epochs: s.epochs_run,
+        train_ms: s.duration_ms,
+        verification: model.verification().cloned().expect("certify recorded it"),
+        tracking,
+    })
+}
+
+/// The demo's tracking phase alone, with `model` (trained and certified): the daemon's loop
+/// drives the simulated hand as `opts.drives` says while the patient tracks the sine; scored
+/// after `opts.settle_s`.
+pub fn track_model(
+    model: &TrainedModel,
+    opts: &DemoOptions,
+    mut on: impl FnMut(DemoEvent<'_>),
+) -> Result<TrackingReport, DemoError> {
+    on(DemoEvent::Phase(match opts.drives {
+        DriveProfile::Native => {
+            "tracking: the daemon drives the hand, the patient follows a sine with the index finger"
+        }
+        DriveProfile::Cia402 => {
+            "tracking: the daemon starts a CiA 402 drive per finger and drives the hand through \
+             them, the patient follows a sine with the index finger"
+        }
+    }));
+    let (
+        Tracked {
+            samples,
+            motion,
+            drives,
+        },
+        end,
+    ) = if opts.fast {
+        track(model, opts, VirtualClock::new(), true, &mut on)?
     } else {
-        track(&model, opts, SystemClock::new(), false, &mut on)?
+        track(model, opts, SystemClock::new(), false, &mut on)?
     };
     let skip = (opts.settle_s * 50.0) as usize;
     let scored = samples.get(skip..).unwrap_or(&[]);
@@ -302,24 +406,18 @@ pub fn run_demo(
     let mean_abs_label: [f64; N_FINGERS] =
         std::array::from_fn(|f| scored.iter().map(|s| s.labels[f].abs()).sum::<f64>() / n);
     let m = tracking_metrics(&target, &tracked)?;
-    let s = model.summary();
-    Ok(DemoReport {
-        session_dir,
-        model_path,
-        trials,
-        epochs: s.epochs_run,
-        train_ms: s.duration_ms,
-        verification: model.verification().cloned().expect("certify recorded it"),
+    Ok(TrackingReport {
         samples: scored.len(),
         rmse: m.rmse,
         mape: m.mape,
         r2: m.r2,
         mean_abs_label,
         mean_abs_velocity: std::array::from_fn(|f| {
-            motion.abs_velocity[f] / motion.setpoints.max(1) as f64
+            motion.abs_velocity[f] / motion.rounds[f].max(1) as f64
         }),
         at_stop_s: motion.at_stop_s,
         impacts: motion.impacts,
+        drives,
         end,
     })
 }
@@ -380,13 +478,26 @@ pub struct ClosedLoop<K: Clock> {
     pub tracking: TrackingConfig,
 }
 
-/// Builds the [`ClosedLoop`] for `model`; `seed` seeds the patient (and, plus one, the
-/// amplifier's noise).
+/// Builds the [`ClosedLoop`] for `model` with native fingers; `seed` seeds the patient (and,
+/// plus one, the amplifier's noise).
 pub fn closed_loop<K: Clock + Clone + Send + Sync + 'static>(
     model: &TrainedModel,
     seed: u64,
     clock: K,
 ) -> Result<ClosedLoop<K>, DemoError> {
+    closed_loop_with(model, seed, clock, DriveProfile::Native)
+}
+
+/// As [`closed_loop`], the fingers moved as `drives` says.
+pub fn closed_loop_with<K: Clock + Clone + Send + Sync + 'static>(
+    model: &TrainedModel,
+    seed: u64,
+    clock: K,
+    drives: DriveProfile,
+) -> Result<ClosedLoop<K>, DemoError> {
+    let config = drives.config();
+    // The drive table checked as handd checks handd.toml, before the engine takes it.
+    config.drives()?;
     let tracking = TrackingConfig {
         seed,
         ..TrackingConfig::default()
@@ -405,6 +516,7 @@ pub fn closed_loop<K: Clock + Clone + Send + Sync + 'static>(
                 ..AmplifierNodeConfig::default()
             },
             start_us,
+            drives: drives.world_drives()?,
             ..WorldConfig::default()
         },
         PatientMode::ClosedLoop(Box::new(patient)),
@@ -414,7 +526,6 @@ pub fn closed_loop<K: Clock + Clone + Send + Sync + 'static>(
         .chain()
         .validate()
         .map_err(|e| DemoError::Gates(format!("the model's chain is invalid: {e}")))?;
-    let config = Config::default();
     let mut engine = Engine::new(
         &chain,
         model.predictor(),
@@ -446,9 +557,10 @@ struct TrackSample {
 /// What every finger did over the scored time.
 #[derive(Debug, Default)]
 struct Motion {
-    /// Setpoint rounds (ticks) seen.
-    setpoints: usize,
-    /// Sum of |velocity setpoint| per finger.
+    /// Velocities summed per finger (setpoints seen, or ticks for a drive's finger).
+    rounds: [usize; N_FINGERS],
+    /// Sum of |velocity| per finger: of the setpoint handd sent a native controller, of the
+    /// joint for a finger on a CiA 402 drive (a torque-mode drive gets a torque, not a speed).
     abs_velocity: [f64; N_FINGERS],
     /// Seconds at a joint stop per finger (FINGER_STATUS bit 5, one status period each).
     at_stop_s: [f64; N_FINGERS],
@@ -460,6 +572,29 @@ struct Motion {
 struct Tracked {
     samples: Vec<TrackSample>,
     motion: Motion,
+    drives: DrivesRecord,
+}
+
+/// How the CiA 402 drives came up (all zero with native fingers).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct DrivesRecord {
+    /// Drives handd ran.
+    pub drives: usize,
+    /// When every drive first followed its target (Operation enabled), s after the loop
+    /// started; None if they never all did.
+    pub all_enabled_s: Option<f64>,
+    /// Drives following their target at the end.
+    pub enabled_at_end: usize,
+}
+
+/// Drives handd runs and how many of them follow their target now.
+fn drives_enabled(engine: &Engine) -> (usize, usize) {
+    (0..N_FINGERS)
+        .filter_map(|f| engine.drive_status(f))
+        .fold((0, 0), |(n, on), s| {
+            let enabled = matches!(s, hand_canopen::DriveStatus::Running { enabled: true, .. });
+            (n + 1, on + usize::from(enabled))
+        })
 }
 
 /// FINGER_STATUS fault bit 5: at a joint stop, the command pushing into it.
@@ -480,7 +615,7 @@ fn track<K: DemoClock>(
         bus,
         start_us: start,
         tracking,
-    } = closed_loop(model, opts.seed, clock.clone())?;
+    } = closed_loop_with(model, opts.seed, clock.clone(), opts.drives)?;
     if opts.law == OutputLaw::Paper {
         for f in 0..N_FINGERS {
             let g = runner.engine().gains()[f].paper_law();
@@ -497,6 +632,8 @@ fn track<K: DemoClock>(
     let end = start + (opts.track_s * 1e6) as u64;
     let mut samples = Vec::new();
     let mut next_live = start;
+    let mut next_felt = start;
+    let mut drives = DrivesRecord::default();
     let mut now = start;
     let mut tracked = 0.0;
     while now < end {
@@ -510,8 +647,42 @@ fn track<K: DemoClock>(
             clock.now_us()
         };
         world.step(now);
+        // As the daemon's real-time loop: the tick at its deadline, the bus read in between
+        // (a CiA 402 drive's start-up answers go out at once, not at the next tick).
         if now >= runner.next_deadline_us() {
             runner.step();
+            let (n, on) = drives_enabled(runner.engine());
+            if n > 0 && on == n && drives.all_enabled_s.is_none() {
+                drives.all_enabled_s = Some(now.saturating_sub(start) as f64 * 1e-6);
+            }
+            if now >= scored_from {
+                for d in world.drive_fingers() {
+                    let f = d.finger();
+                    motion.abs_velocity[f] += d.physics().velocity_rad_s.abs();
+                    motion.rounds[f] += 1;
+                }
+            }
+        } else if now >= runner.next_wake_us() {
+            runner.service_bus();
+        }
+        // A drive's finger reports no FINGER_STATUS: read at the native status rate.
+        if now >= next_felt {
+            next_felt += (status_period_s * 1e6) as u64;
+            for d in world.drive_fingers() {
+                let (f, p) = (d.finger(), d.physics());
+                if now >= scored_from && p.at_limit {
+                    motion.at_stop_s[f] += status_period_s;
+                }
+                if f == tracking.finger {
+                    tracked = p.force_n / tracking.full_scale_force_n;
+                    let snap = *runner.snapshot().lock().unwrap_or_else(|e| e.into_inner());
+                    samples.push(TrackSample {
+                        target: tracking.target.at(now.saturating_sub(start)),
+                        tracked,
+                        labels: snap.labels,
+                    });
+                }
+            }
         }
         while let Some(r) = probe.receive_timestamped() {
             let id = r.frame.raw_id();
@@ -520,7 +691,7 @@ fn track<K: DemoClock>(
                 if let Some(f) = FingerSetpoint::instance_of(id) {
                     if let Ok(sp) = FingerSetpoint::decode(id, r.frame.data()) {
                         motion.abs_velocity[f] += sp.velocity().abs();
-                        motion.setpoints += usize::from(f == 0);
+                        motion.rounds[f] += 1;
                     }
                 }
                 if let Some(f) = FingerStatus::instance_of(id) {
@@ -556,10 +727,22 @@ fn track<K: DemoClock>(
             });
         }
     }
-    for (f, finger) in world.fingers().enumerate().take(N_FINGERS) {
+    for finger in world.fingers() {
         let m = finger.motion_stats();
-        motion.impacts[f] = (m.impacts, m.max_impact_speed_rad_s);
+        motion.impacts[finger.finger()] = (m.impacts, m.max_impact_speed_rad_s);
     }
+    for d in world.drive_fingers() {
+        let m = d.physics().stats;
+        motion.impacts[d.finger()] = (m.impacts, m.max_impact_speed_rad_s);
+    }
+    (drives.drives, drives.enabled_at_end) = drives_enabled(runner.engine());
     let snap = *runner.snapshot().lock().unwrap_or_else(|e| e.into_inner());
-    Ok((Tracked { samples, motion }, snap))
+    Ok((
+        Tracked {
+            samples,
+            motion,
+            drives,
+        },
+        snap,
+    ))
 }

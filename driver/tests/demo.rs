@@ -1,7 +1,7 @@
 //! The embedded demo end to end on a virtual clock: simulated calibration, ResDD training, the
 //! real daemon loop, and the simulated patient tracking a sine with the index finger.
 
-use driver::demo::{run_demo, DemoEvent, DemoOptions};
+use driver::demo::{run_demo, track_model, DemoEvent, DemoOptions, DriveProfile};
 
 #[test]
 fn demo_calibrates_trains_and_tracks_a_sine() {
@@ -13,19 +13,20 @@ fn demo_calibrates_trains_and_tracks_a_sine() {
     };
     let mut phases = 0;
     let mut live = 0;
-    let r = run_demo(&opts, |e| match e {
+    let demo = run_demo(&opts, |e| match e {
         DemoEvent::Phase(_) => phases += 1,
         DemoEvent::Live { .. } => live += 1,
         DemoEvent::Epoch(_) => {}
     })
     .unwrap();
+    let r = &demo.tracking;
     println!(
         "trials {} epochs {} train {} ms; tracking over {} samples: RMSE {:.3} MAPE {:?} R² {:.3}; latency {:?}",
-        r.trials, r.epochs, r.train_ms, r.samples, r.rmse, r.mape, r.r2, r.end.latency
+        demo.trials, demo.epochs, demo.train_ms, r.samples, r.rmse, r.mape, r.r2, r.end.latency
     );
     assert_eq!(phases, 3);
     assert!(live >= 90, "live updates every 250 ms: {live}");
-    assert!(r.trials >= 30, "{}", r.trials);
+    assert!(demo.trials >= 30, "{}", demo.trials);
     assert!(r.samples >= 900, "20 s of 50 Hz status: {}", r.samples);
     println!(
         "selectivity: mean |label| per finger {:?}",
@@ -47,16 +48,63 @@ fn demo_calibrates_trains_and_tracks_a_sine() {
         r.mean_abs_label[1]
     );
     assert_eq!(r.end.counters.deadline_misses, 0);
-    assert!(std::fs::metadata(&r.model_path).unwrap().len() > 1000);
+    assert!(std::fs::metadata(&demo.model_path).unwrap().len() > 1000);
     // The model proved itself before it drove the hand, and its file says so.
     assert!(
-        r.verification.passed() && !r.verification.forced,
+        demo.verification.passed() && !demo.verification.forced,
         "{}",
-        r.verification
+        demo.verification
     );
-    let saved = decoder::model::TrainedModel::load(&r.model_path, None).unwrap();
-    assert_eq!(saved.verification(), Some(&r.verification));
+    let saved = decoder::model::TrainedModel::load(&demo.model_path, None).unwrap();
+    assert_eq!(saved.verification(), Some(&demo.verification));
     assert_eq!(saved.rest_rms_uv().map(<[f64]>::len), Some(12));
+    assert_eq!(r.drives.drives, 0, "native fingers: no CiA 402 drive");
+
+    // Issue 26 item 6: the same model, every finger on a simulated CiA 402 drive that the
+    // daemon starts over the bus and drives in torque mode: it tracks as natively (R² >= 0.8).
+    let cia402 = DemoOptions {
+        drives: DriveProfile::Cia402,
+        ..opts.clone()
+    };
+    let d = track_model(&saved, &cia402, |_| {}).unwrap();
+    println!(
+        "native:  R² {:.3} RMSE {:.3} MAPE {:?}, off-target mean |label| {:?}\n\
+         cia402:  R² {:.3} RMSE {:.3} MAPE {:?}, off-target mean |label| {:?}; drives {:?}, \
+         deadline misses {}",
+        r.r2,
+        r.rmse,
+        r.mape,
+        r.mean_abs_label,
+        d.r2,
+        d.rmse,
+        d.mape,
+        d.mean_abs_label,
+        d.drives,
+        d.end.counters.deadline_misses
+    );
+    assert_eq!(d.drives.drives, 5, "a drive per finger: {:?}", d.drives);
+    assert!(
+        d.drives.all_enabled_s.is_some_and(|t| t < opts.settle_s),
+        "every drive follows its target before the score starts: {:?}",
+        d.drives
+    );
+    assert_eq!(d.drives.enabled_at_end, 5, "{:?}", d.drives);
+    assert!(d.samples >= 900, "20 s of 50 Hz readings: {}", d.samples);
+    assert!(
+        d.r2 >= 0.8,
+        "tracking R² through the drives {:.3} (RMSE {:.3})",
+        d.r2,
+        d.rmse
+    );
+    for f in [0, 2, 3, 4] {
+        assert!(
+            d.mean_abs_label[f] <= 0.15,
+            "finger {f} follows the index: mean |label| {:.3} (all {:?})",
+            d.mean_abs_label[f],
+            d.mean_abs_label
+        );
+    }
+    assert_eq!(d.end.counters.deadline_misses, 0);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

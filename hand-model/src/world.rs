@@ -45,6 +45,10 @@ pub struct World<B: Bus> {
     drives: Vec<(DriveFingerNode, B)>,
     injector: (FaultInjector, B),
     intent: Intent,
+    /// How often a closed-loop patient feels a drive-moved finger (the native status period),
+    /// and when next, µs since the start.
+    felt_period_us: u64,
+    next_felt_us: u64,
 }
 
 /// Which nodes a world runs (for `handsim` beside real hardware, e.g. only the amplifier).
@@ -190,6 +194,8 @@ impl<B: Bus> World<B> {
             drives,
             injector,
             intent: Intent::REST,
+            felt_period_us: cfg.finger.status_period_us,
+            next_felt_us: 0,
         })
     }
 
@@ -226,6 +232,24 @@ impl<B: Bus> World<B> {
             node.poll(now_us, bus);
         }
         self.injector.0.poll(now_us, &mut self.injector.1);
+        self.feel_drive_finger(rel);
+    }
+
+    /// A closed-loop patient whose finger a CiA 402 drive moves: no FINGER_STATUS comes from a
+    /// drive, so the patient feels the finger's force itself, at the native status rate (the
+    /// same reading a native controller reports, with the same reaction delay after it).
+    fn feel_drive_finger(&mut self, rel_us: u64) {
+        let PatientMode::ClosedLoop(user) = &mut self.patient else {
+            return;
+        };
+        if rel_us < self.next_felt_us {
+            return;
+        }
+        let finger = user.config().finger;
+        if let Some((node, _)) = self.drives.iter().find(|(n, _)| n.finger() == finger) {
+            user.observe(rel_us, node.physics().force_n);
+            self.next_felt_us = rel_us + self.felt_period_us;
+        }
     }
 
     /// The intent the patient had at the last step.

@@ -252,6 +252,20 @@ pub struct DemoArgs {
     /// (the paper's `ω = ω0 + α·t`, held at rest), to compare the two.
     #[arg(long, value_enum, default_value_t = DemoLaw::Shipped)]
     pub law: DemoLaw,
+    /// What moves the fingers while tracking: `native` (hand.dbc's finger controllers) or
+    /// `cia402` (a simulated CiA 402 drive per finger, node 5 + finger, torque mode, started
+    /// and driven by the daemon over CANopen).
+    #[arg(long, value_enum, default_value_t = DemoDrives::Native)]
+    pub drives: DemoDrives,
+}
+
+/// `handctl demo --drives`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DemoDrives {
+    /// hand.dbc's native finger controllers.
+    Native,
+    /// A simulated CiA 402 drive per finger.
+    Cia402,
 }
 
 /// `handctl demo --law`.

@@ -4,10 +4,10 @@
 
 use std::io::{IsTerminal, Write};
 
-use driver::demo::{run_demo, DemoEvent, DemoOptions, OutputLaw};
+use driver::demo::{run_demo, DemoEvent, DemoOptions, DriveProfile, DrivesRecord, OutputLaw};
 use driver::units::FINGER_NAMES;
 
-use super::args::{DemoArgs, DemoLaw};
+use super::args::{DemoArgs, DemoDrives, DemoLaw};
 use super::error::CliError;
 use super::progress::Progress;
 
@@ -27,6 +27,10 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
         law: match a.law {
             DemoLaw::Shipped => OutputLaw::Shipped,
             DemoLaw::Paper => OutputLaw::Paper,
+        },
+        drives: match a.drives {
+            DemoDrives::Native => DriveProfile::Native,
+            DemoDrives::Cia402 => DriveProfile::Cia402,
         },
         ..DemoOptions::default()
     };
@@ -88,31 +92,55 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
     println!("model effort rays: {}", report.verification);
     println!(
         "tracking (index finger, sine amplitude 1, period 4 s, {} samples): RMSE {:.3}  MAPE {}  R² {:.3}",
-        report.samples,
-        report.rmse,
-        report.mape.map_or("n/a".into(), |m| format!("{m:.1}%")),
-        report.r2
+        report.tracking.samples,
+        report.tracking.rmse,
+        report.tracking.mape.map_or("n/a".into(), |m| format!("{m:.1}%")),
+        report.tracking.r2
     );
-    println!("{}", selectivity(&report.mean_abs_label));
+    println!("{}", selectivity(&report.tracking.mean_abs_label));
     println!(
         "output law {:?}: {}",
         a.law,
         motion(
-            &report.mean_abs_velocity,
-            &report.at_stop_s,
-            &report.impacts
+            &report.tracking.mean_abs_velocity,
+            &report.tracking.at_stop_s,
+            &report.tracking.impacts,
+            match a.drives {
+                DemoDrives::Native => "velocity setpoint",
+                // A torque-mode drive gets a torque: the joint's own velocity instead.
+                DemoDrives::Cia402 => "joint velocity",
+            }
         )
     );
+    if let Some(line) = drives_line(&report.tracking.drives) {
+        println!("{line}");
+    }
     println!(
         "daemon: latency p50 {} us p99 {} us, compute p50 {} us p99 {} us, deadline misses {}, state {}",
-        report.end.latency.p50_us,
-        report.end.latency.p99_us,
-        report.end.compute.p50_us,
-        report.end.compute.p99_us,
-        report.end.counters.deadline_misses,
-        report.end.state
+        report.tracking.end.latency.p50_us,
+        report.tracking.end.latency.p99_us,
+        report.tracking.end.compute.p50_us,
+        report.tracking.end.compute.p99_us,
+        report.tracking.end.counters.deadline_misses,
+        report.tracking.end.state
     );
     Ok(())
+}
+
+/// The CiA 402 drives' line (None with native fingers).
+fn drives_line(d: &DrivesRecord) -> Option<String> {
+    (d.drives > 0).then(|| {
+        format!(
+            "CiA 402 drives: {} started by the daemon, all following their target {}; {} of {} \
+             following at the end",
+            d.drives,
+            d.all_enabled_s.map_or("NEVER".to_string(), |t| format!(
+                "{t:.2} s after the loop started"
+            )),
+            d.enabled_at_end,
+            d.drives
+        )
+    })
 }
 
 /// The selectivity line: the mean |label| of every finger while the index tracks.
@@ -126,9 +154,14 @@ fn selectivity(mean_abs_label: &[f64; 5]) -> String {
     )
 }
 
-/// The output law's line: per finger, the mean |velocity setpoint|, the time at a joint stop,
-/// and the impacts into a stop with the fastest.
-fn motion(mean_abs_velocity: &[f64; 5], at_stop_s: &[f64; 5], impacts: &[(u64, f64); 5]) -> String {
+/// The output law's line: per finger, the mean |velocity| (`velocity`: of what), the time at a
+/// joint stop, and the impacts into a stop with the fastest.
+fn motion(
+    mean_abs_velocity: &[f64; 5],
+    at_stop_s: &[f64; 5],
+    impacts: &[(u64, f64); 5],
+    velocity: &str,
+) -> String {
     let fingers: Vec<String> = (0..5)
         .map(|f| {
             format!(
@@ -138,7 +171,7 @@ fn motion(mean_abs_velocity: &[f64; 5], at_stop_s: &[f64; 5], impacts: &[(u64, f
         })
         .collect();
     format!(
-        "per finger: mean |velocity setpoint|, time at a joint stop, impacts into a stop: {}",
+        "per finger: mean |{velocity}|, time at a joint stop, impacts into a stop: {}",
         fingers.join(", ")
     )
 }

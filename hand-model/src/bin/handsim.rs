@@ -74,6 +74,10 @@ struct Args {
     /// 1000 per mille and 8000 rpm). handd needs the matching `[fingers.NAME.drive]` tables.
     #[arg(long, value_name = "FINGERS")]
     cia402: Option<String>,
+    /// What moves the fingers: `cia402` puts every finger on a simulated CiA 402 drive (as
+    /// `--cia402 01234`); `native` their native controllers.
+    #[arg(long, value_enum, conflicts_with = "cia402")]
+    drives: Option<Drives>,
     /// Write the scenario's calibration trials (session.toml `[[trial]]` form) to this file.
     #[arg(long)]
     trials_out: Option<std::path::PathBuf>,
@@ -128,6 +132,15 @@ fn parse_fault(spec: &str, duration_us: u64) -> Result<(Fault, u64, u64), SimErr
     Ok((fault, from, until))
 }
 
+/// `--drives`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Drives {
+    /// hand.dbc's native finger controllers.
+    Native,
+    /// A simulated CiA 402 drive per finger.
+    Cia402,
+}
+
 /// The simulated CiA 402 drives `--cia402 FINGERS` asks for.
 fn sim_drives(
     fingers: Option<&str>,
@@ -141,20 +154,9 @@ fn sim_drives(
             "--cia402 {s:?}: use finger digits 0 (thumb) to 4 (pinky), e.g. 1 or 012"
         ))
     })?;
-    let scaling = hand_canopen::scaling::ScalingSettings {
-        rated_torque_mnm: 25.0,
-        gear_ratio: 64.0,
-        moment_arm_m: 0.04,
-        max_torque_permille: 1000,
-        max_speed_rpm: 8000,
-    }
-    .validate()
-    .map_err(|e| SimError::BadScript(format!("--cia402: {e}")))?;
     for (f, slot) in out.iter_mut().enumerate() {
         if mask & (1 << f) != 0 {
-            let node = hand_canopen::NodeId::try_new(5 + f as u8)
-                .map_err(|e| SimError::BadScript(format!("--cia402: {e}")))?;
-            *slot = Some(hand_model::nodes::DriveFingerConfig { node, scaling });
+            *slot = Some(hand_model::nodes::DriveFingerConfig::simulated(f)?);
         }
     }
     Ok(out)
@@ -256,7 +258,12 @@ fn run() -> Result<(), String> {
             fingers: parse_fingers(&args.fingers).map_err(|e| e.to_string())?,
         },
         start_us: 0,
-        drives: sim_drives(args.cia402.as_deref()).map_err(|e| e.to_string())?,
+        drives: sim_drives(match args.drives {
+            Some(Drives::Cia402) => Some("01234"),
+            Some(Drives::Native) => None,
+            None => args.cia402.as_deref(),
+        })
+        .map_err(|e| e.to_string())?,
     };
     match (&args.iface, args.mem) {
         (Some(iface), false) => {

@@ -36,6 +36,39 @@ pub struct DriveFingerConfig {
     pub scaling: Scaling,
 }
 
+/// The node id of finger `f`'s simulated drive: 5 + f (the native controllers' node ids,
+/// hand.dbc's 0-4, are left free; handd is 127).
+pub const fn simulated_node_id(finger: usize) -> u8 {
+    5 + finger as u8
+}
+
+impl DriveFingerConfig {
+    /// The scaling of every simulated finger drive (`handsim --cia402`, `handctl demo
+    /// --drives cia402`): a 25 mNm motor through a 64:1 gear on a 40 mm moment arm, so full
+    /// torque is 40 N at the fingertip, and 8000 rpm at most.
+    pub const SIM_SCALING: hand_canopen::scaling::ScalingSettings =
+        hand_canopen::scaling::ScalingSettings {
+            rated_torque_mnm: 25.0,
+            gear_ratio: 64.0,
+            moment_arm_m: 0.04,
+            max_torque_permille: 1000,
+            max_speed_rpm: 8000,
+        };
+
+    /// Finger `finger`'s simulated drive: node [`simulated_node_id`], [`Self::SIM_SCALING`].
+    pub fn simulated(finger: usize) -> Result<Self, SimError> {
+        if finger >= N_FINGERS {
+            return Err(SimError::BadFinger(finger));
+        }
+        let node = NodeId::try_new(simulated_node_id(finger))
+            .map_err(|e| SimError::BadScript(format!("drive of finger {finger}: {e}")))?;
+        let scaling = Self::SIM_SCALING
+            .validate()
+            .map_err(|e| SimError::BadScript(format!("drive scaling: {e}")))?;
+        Ok(Self { node, scaling })
+    }
+}
+
 /// `magnitude` in the direction of `x` (0 for 0: `f64::signum` would give 1).
 fn toward(x: f64, magnitude: f64) -> f64 {
     if x > 0.0 {
