@@ -115,6 +115,10 @@ pub struct Live {
     pub rest_rms_uv: Option<Vec<f64>>,
     /// Per finger, 0 thumb .. 4 pinky.
     pub fingers: Vec<FingerLive>,
+    /// Each CiA 402 finger's drive (none when every finger is native, and from a daemon older
+    /// than this field).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub drives: Vec<crate::protocol::DriveLine>,
 }
 
 impl Live {
@@ -163,6 +167,7 @@ impl Live {
                     active: s.active[f],
                 })
                 .collect(),
+            drives: crate::protocol::drive_lines(&s.drives, s.t_us),
         }
     }
 }

@@ -5,6 +5,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::stats::Percentiles;
+use crate::units::{FINGER_NAMES, N_FINGERS};
 
 /// A request from `handctl`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -193,11 +194,40 @@ pub struct DriveLine {
     pub state: String,
     /// A latched fault: the finger is stopped until `handctl arm`.
     pub faulted: bool,
+    /// Its NMT state as handd drives it: `starting` (start-up: reset, pre-operational,
+    /// configuration), `operational`, or `stopped` after a fault (empty from an older daemon).
+    #[serde(default, skip_serializing_if = "String::is_empty")]
+    pub nmt: String,
+    /// Its CiA 402 power state from the newest TPDO1 statusword (`None` before the first).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub power_state: Option<String>,
+    /// Age of the newest TPDO1 at the time of the status, ms (`None` before the first).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub feedback_age_ms: Option<u64>,
+    /// The EMCY that stopped it: code and meaning (`None` unless an EMCY did).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub emcy: Option<String>,
+}
+
+/// Every CiA 402 finger's line, from the loop's per-finger drive states at `now_us`.
+pub fn drive_lines(
+    drives: &[Option<(u8, hand_canopen::DriveStatus)>; N_FINGERS],
+    now_us: u64,
+) -> Vec<DriveLine> {
+    drives
+        .iter()
+        .enumerate()
+        .filter_map(|(f, d)| {
+            let (node, st) = d.as_ref()?;
+            Some(DriveLine::of(FINGER_NAMES[f], *node, st, now_us))
+        })
+        .collect()
 }
 
 impl DriveLine {
-    /// The line for finger `finger`'s drive on `node` in `status`.
-    pub fn of(finger: &str, node: u8, status: &hand_canopen::DriveStatus) -> Self {
+    /// The line for finger `finger`'s drive on `node` in `status` at `now_us` (the status's
+    /// time, for the feedback's age).
+    pub fn of(finger: &str, node: u8, status: &hand_canopen::DriveStatus, now_us: u64) -> Self {
         use hand_canopen::DriveStatus as S;
         let state = match status {
             S::Starting(step) => format!("starting: {step}"),
@@ -218,11 +248,33 @@ impl DriveLine {
             ),
             S::Faulted(fault) => format!("stopped: {fault}; `handctl arm` starts it again"),
         };
+        let feedback = match status {
+            S::Running { feedback, .. } => *feedback,
+            _ => None,
+        };
         Self {
             finger: finger.into(),
             node,
             state,
             faulted: matches!(status, S::Faulted(_)),
+            nmt: match status {
+                S::Starting(_) => "starting",
+                S::Running { .. } => "operational",
+                S::Faulted(_) => "stopped",
+            }
+            .into(),
+            power_state: feedback.map(|fb| {
+                fb.statusword
+                    .state()
+                    .map_or("unknown".into(), |p| p.to_string())
+            }),
+            feedback_age_ms: feedback.map(|fb| now_us.saturating_sub(fb.at_us) / 1000),
+            emcy: match status {
+                S::Faulted(hand_canopen::DriveFault::Emcy(e)) => {
+                    Some(format!("0x{:04X} {}", e.code, e.meaning()))
+                }
+                _ => None,
+            },
         }
     }
 }

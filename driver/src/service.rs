@@ -167,12 +167,7 @@ impl ControlHandler {
                 controller: s.bus.state.name().into(),
                 counters: s.bus.counters,
             },
-            drives: (0..N_FINGERS)
-                .filter_map(|f| {
-                    let (node, st) = s.drives[f]?;
-                    Some(crate::protocol::DriveLine::of(FINGER_NAMES[f], node, &st))
-                })
-                .collect(),
+            drives: crate::protocol::drive_lines(&s.drives, s.t_us),
             late_ticks: s.late_ticks().collect(),
         }
     }

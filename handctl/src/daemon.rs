@@ -151,6 +151,9 @@ pub fn format_status(s: &Status) -> String {
                 d.node,
                 d.state
             );
+            if let Some(detail) = drive_detail(d) {
+                out += &format!("{:18}{detail}\n", "");
+            }
         }
     }
     if !s.late_ticks.is_empty() {
@@ -214,6 +217,26 @@ pub fn arm(a: &ArmArgs) -> Result<(), CliError> {
 /// `handctl stop`.
 pub fn stop(o: &DaemonOpts) -> Result<(), CliError> {
     done(ask(o, &Request::Stop)?).map(drop)
+}
+
+/// A drive's second line: NMT, CiA 402 power state, feedback age, the EMCY that stopped it
+/// (None from a daemon older than these fields).
+fn drive_detail(d: &driver::protocol::DriveLine) -> Option<String> {
+    if d.nmt.is_empty() {
+        return None;
+    }
+    let mut parts = vec![format!("NMT {}", d.nmt)];
+    if let Some(p) = &d.power_state {
+        parts.push(format!("CiA 402 {p}"));
+    }
+    parts.push(match d.feedback_age_ms {
+        Some(a) => format!("TPDO1 {a} ms ago"),
+        None => "no TPDO1 yet".into(),
+    });
+    if let Some(e) = &d.emcy {
+        parts.push(format!("EMCY {e}"));
+    }
+    Some(parts.join(", "))
 }
 
 #[cfg(test)]
@@ -294,10 +317,35 @@ mod tests {
             },
             feedback: None,
         };
+        let with_feedback = DriveStatus::Running {
+            enabled: true,
+            identity: Identity::default(),
+            feedback: Some(hand_canopen::master::Feedback {
+                statusword: hand_canopen::Statusword::of(
+                    hand_canopen::PowerState::OperationEnabled,
+                ),
+                torque_permille: 0,
+                velocity_rpm: 0,
+                at_us: 1_000_000,
+            }),
+        };
+        let trip = hand_canopen::Emcy {
+            node: hand_canopen::NodeId::try_new(8).unwrap(),
+            code: 0x2310,
+            register: 0x03,
+            vendor: [0; 5],
+        };
         let s = Status {
             drives: vec![
-                DriveLine::of("index", 5, &running),
-                DriveLine::of("middle", 6, &DriveStatus::Faulted(DriveFault::Rebooted)),
+                DriveLine::of("index", 5, &running, 1_000_000),
+                DriveLine::of(
+                    "middle",
+                    6,
+                    &DriveStatus::Faulted(DriveFault::Rebooted),
+                    1_000_000,
+                ),
+                DriveLine::of("ring", 7, &with_feedback, 1_012_500),
+                DriveLine::of("pinky", 8, &DriveStatus::Faulted(DriveFault::Emcy(trip)), 0),
             ],
             ..Status::default()
         };
@@ -305,16 +353,26 @@ mod tests {
         assert!(
             text.contains(
                 "\nCiA 402 drives\nindex   node   5  Operation enabled, following its setpoint \
-                 (vendor 0x000000FB, product 0x60500000)\n"
+                 (vendor 0x000000FB, product 0x60500000)\n                  NMT operational, \
+                 no TPDO1 yet\n"
             ),
             "{text}"
         );
         assert!(
             text.contains(
                 "\n!! middle  node   6  stopped: booted while configured (power cycle or reset); \
-                 reconfigured on arm; `handctl arm` starts it again\n"
+                 reconfigured on arm; `handctl arm` starts it again\n                  NMT \
+                 stopped, no TPDO1 yet\n"
             ),
             "{text}"
+        );
+        assert!(
+            text.contains("NMT operational, CiA 402 Operation enabled, TPDO1 12 ms ago\n"),
+            "{text}"
+        );
+        assert!(
+            text.contains("NMT stopped, no TPDO1 yet, EMCY 0x2310 "),
+            "the EMCY that stopped the drive, with its meaning: {text}"
         );
         // Every finger native: no drive section, and the field is not sent.
         assert!(!format_status(&Status::default()).contains("CiA 402"));

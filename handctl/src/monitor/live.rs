@@ -30,6 +30,7 @@ impl MonitorState {
             v.disabled = f.disabled;
             v.active = f.active;
         }
+        self.drives.clone_from(&l.drives);
         let d = &mut self.daemon;
         d.state = Some(l.state.clone());
         d.faults.clone_from(&l.faults);
@@ -102,5 +103,19 @@ mod tests {
         assert_eq!(s.daemon.deadline_misses, 2);
         assert_eq!(s.history.len(), 1);
         assert_eq!(s.t_us, 5_000_000);
+        assert!(s.drives.is_empty(), "every finger native: no drive line");
+        let with_drive = line.replace(
+            r#""a_field_added_later":1"#,
+            r#""drives":[{"finger":"index","node":6,"state":"Operation enabled",
+                "faulted":false,"nmt":"operational","power_state":"Operation enabled",
+                "feedback_age_ms":12}]"#,
+        );
+        let live: Live = serde_json::from_str(&with_drive).expect("the schema parses");
+        s.apply_live(&live);
+        assert_eq!(s.drives.len(), 1);
+        assert_eq!(
+            (s.drives[0].node, s.drives[0].feedback_age_ms),
+            (6, Some(12))
+        );
     }
 }

@@ -5,6 +5,7 @@ use hand_dbc::hand::FINGER_NAMES;
 
 use super::cpu::CpuMeter;
 use super::state::MonitorState;
+use super::widgets::drive_cell;
 
 /// Prints a line whenever a second of source time has passed.
 #[derive(Debug, Clone, Default)]
@@ -56,9 +57,19 @@ pub fn line(st: &MonitorState, cpu: &CpuMeter) -> String {
             if v.disabled { "!" } else { "" }
         )
     }));
+    let drives = if st.drives.is_empty() {
+        String::new()
+    } else {
+        let each: Vec<String> = st
+            .drives
+            .iter()
+            .map(|d| format!("{} n{} {}", d.finger, d.node, drive_cell(d)))
+            .collect();
+        format!(" | drives {}", each.join(", "))
+    };
     let (c, w) = cpu.used();
     format!(
-        "t {:.1} s {} faults {} model {} | latency p50 {} p99 {} us misses {} e2e {} lost {} beyond {} implausible {} bus {} CAN {} | rms uV {rms} | label/F/reported {fingers} | cpu {:.1}%",
+        "t {:.1} s {} faults {} model {} | latency p50 {} p99 {} us misses {} e2e {} lost {} beyond {} implausible {} bus {} CAN {} | rms uV {rms} | label/F/reported {fingers}{drives} | cpu {:.1}%",
         st.elapsed_s(),
         d.state.as_deref().unwrap_or("--"),
         if d.faults.is_empty() { "none".to_owned() } else { d.faults.join(",") },

@@ -43,6 +43,7 @@ pub fn draw(frame: &mut Frame<'_>, st: &MonitorState, view: &View) {
         FingerTable {
             fingers: &st.fingers,
             selected: view.finger,
+            drives: &st.drives,
         },
         right,
     );
@@ -101,5 +102,75 @@ mod tests {
         assert!(all.contains("pinky"), "{all}");
         // All 12 channels are on screen.
         assert!(rows.iter().any(|r| r.starts_with("│11    0.0 ")), "{all}");
+        assert!(
+            !all.contains("CiA 402"),
+            "no drive, no drive section: {all}"
+        );
+    }
+
+    /// Issue 26 item 9: the finger panel lists every CiA 402 drive at 80x24: its node, power
+    /// state and feedback age, or the EMCY that stopped it, flagged; the plain line too.
+    #[test]
+    fn five_drives_fit_the_finger_panel_at_80x24() {
+        use driver::protocol::DriveLine;
+        use hand_canopen::master::{DriveFault, DriveStatus, Feedback};
+        use hand_canopen::{Emcy, NodeId, PowerState, Statusword};
+        let running = |at_us| DriveStatus::Running {
+            enabled: true,
+            identity: Default::default(),
+            feedback: Some(Feedback {
+                statusword: Statusword::of(PowerState::OperationEnabled),
+                torque_permille: 0,
+                velocity_rpm: 0,
+                at_us,
+            }),
+        };
+        let trip = Emcy {
+            node: NodeId::try_new(9).unwrap(),
+            code: 0x2310,
+            register: 0x03,
+            vendor: [0; 5],
+        };
+        let now = 5_000_000;
+        let mut st = MonitorState::new("daemon", 12);
+        st.drives = vec![
+            DriveLine::of("thumb", 5, &running(now - 12_000), now),
+            DriveLine::of("index", 6, &running(now - 3_000), now),
+            DriveLine::of(
+                "middle",
+                7,
+                &DriveStatus::Faulted(DriveFault::Rebooted),
+                now,
+            ),
+            DriveLine::of(
+                "ring",
+                8,
+                &DriveStatus::Starting(hand_canopen::startup::Step::ResetCommunication),
+                now,
+            ),
+            DriveLine::of(
+                "pinky",
+                9,
+                &DriveStatus::Faulted(DriveFault::Emcy(trip)),
+                now,
+            ),
+        ];
+        let rows = render_text(&st, &View::default(), 80, 24);
+        let all = rows.join("\n");
+        for want in [
+            "CiA 402 drives",
+            "  thumb  n5   Operation enabled 12ms",
+            "  index  n6   Operation enabled 3ms",
+            "!!middle n7   STOPPED (arm)",
+            "  ring   n8   starting",
+            "!!pinky  n9   STOPPED EMCY 0x2310",
+        ] {
+            assert!(all.contains(want), "{want:?} missing:\n{all}");
+        }
+        let l = super::super::plain::line(&st, &super::super::cpu::CpuMeter::start());
+        assert!(
+            l.contains("| drives thumb n5 Operation enabled 12ms, index n6 Operation enabled 3ms"),
+            "{l}"
+        );
     }
 }

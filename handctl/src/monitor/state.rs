@@ -141,6 +141,8 @@ pub struct MonitorState {
     pub daemon: DaemonView,
     /// The plot's history.
     pub history: History,
+    /// Each CiA 402 finger's drive (the daemon source only; empty when every finger is native).
+    pub drives: Vec<driver::protocol::DriveLine>,
     /// The source ended (end of the log, daemon gone), and why.
     pub ended: Option<String>,
 }
@@ -156,6 +158,7 @@ impl MonitorState {
             fingers: vec![FingerView::default(); N_FINGERS],
             daemon: DaemonView::default(),
             history: History::default(),
+            drives: Vec::new(),
             ended: None,
         }
     }

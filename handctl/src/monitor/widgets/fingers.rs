@@ -1,14 +1,18 @@
 //! Per finger: conditioned label, commanded force and velocity, the controller's reported
 //! position and force, and whether it is active, holding or disabled; the selected finger
-//! (the plot's) marked with `>`.
+//! (the plot's) marked with `>`. Below, each CiA 402 finger's drive: its node, its CiA 402
+//! power state and how old its last TPDO1 is, or why it is stopped (the EMCY code), `!!` when
+//! stopped.
 
 use ratatui::buffer::Buffer;
 use ratatui::layout::Rect;
-use ratatui::style::{Modifier, Style};
+use ratatui::style::{Color, Modifier, Style};
 use ratatui::text::Line;
 use ratatui::widgets::{Block, Borders, Paragraph, Widget};
 
 use hand_dbc::hand::FINGER_NAMES;
+
+use driver::protocol::DriveLine;
 
 use crate::monitor::state::FingerView;
 
@@ -18,6 +22,26 @@ pub struct FingerTable<'a> {
     pub fingers: &'a [FingerView],
     /// The selected finger.
     pub selected: usize,
+    /// The CiA 402 fingers' drives (empty: every finger native).
+    pub drives: &'a [DriveLine],
+}
+
+/// A drive's state in a few words: `Operation enabled 12ms` (its CiA 402 power state and the
+/// age of its TPDO1), `starting`, `STOPPED EMCY 0x2310`, `STOPPED (arm)`.
+pub fn drive_cell(d: &DriveLine) -> String {
+    if let Some(e) = &d.emcy {
+        let code = e.split_whitespace().next().unwrap_or("");
+        return format!("STOPPED EMCY {code}");
+    }
+    if d.faulted {
+        return "STOPPED (arm)".into();
+    }
+    match (&d.power_state, d.feedback_age_ms) {
+        (Some(p), Some(a)) => format!("{p} {a}ms"),
+        (Some(p), None) => p.clone(),
+        (None, _) if d.nmt == "starting" => "starting".into(),
+        (None, _) => format!("{} no TPDO1", d.nmt),
+    }
 }
 
 /// The header row.
@@ -58,6 +82,27 @@ impl Widget for FingerTable<'_> {
             let text = Self::row(f, v, f == self.selected);
             let style = if f == self.selected {
                 Style::default().add_modifier(Modifier::REVERSED)
+            } else {
+                Style::default()
+            };
+            lines.push(Line::styled(text, style));
+        }
+        if !self.drives.is_empty() {
+            lines.push(Line::styled(
+                " CiA 402 drives",
+                Style::default().add_modifier(Modifier::BOLD),
+            ));
+        }
+        for d in self.drives {
+            let text = format!(
+                "{}{:<6} n{:<3} {}",
+                if d.faulted { "!!" } else { "  " },
+                d.finger,
+                d.node,
+                drive_cell(d)
+            );
+            let style = if d.faulted {
+                Style::default().fg(Color::Red).add_modifier(Modifier::BOLD)
             } else {
                 Style::default()
             };

@@ -8,5 +8,5 @@ mod plot;
 
 pub use channels::{bar_cells, ChannelBars};
 pub use daemon::{Baseline, DaemonPanel};
-pub use fingers::FingerTable;
+pub use fingers::{drive_cell, FingerTable};
 pub use plot::FingerPlot;
