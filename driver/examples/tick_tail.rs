@@ -2,7 +2,8 @@
 //! 100,000 ticks of recorded traffic, from a histogram of the thread's CPU time per tick, and
 //! where the time goes (front end, filters, features, model, the rest) as a table.
 //!
-//! `cargo run --release -p driver --features sim --example tick_tail -- [--ticks N] [--json]`
+//! `cargo run --release -p driver --features sim --example tick_tail -- [--ticks N] [--json]
+//! [--drives cia402]`
 //!
 //! The traffic is 20 s of a patient flexing and extending the whole hand, recorded from the
 //! simulated amplifier and fingers on the in-memory bus (the same as `benches/tick.rs`), then
@@ -11,6 +12,14 @@
 //! `tick` (faults, features, model, conditioning, encoding) plus `written`. Each tick is timed
 //! with `CLOCK_THREAD_CPUTIME_ID` (`cpu-time`), whose own cost (two reads, measured and
 //! reported) is in every figure. The breakdown times each stage alone over the same ticks.
+//!
+//! `--drives cia402`: every finger on a simulated CiA 402 drive (node 5 + finger, torque mode),
+//! as `handctl demo --drives cia402` runs them. The native controllers' FINGER_STATUS frames
+//! leave the traffic; each tick the engine's frames (its RPDO1s, SYNC, heartbeat, and any
+//! start-up SDO) reach the drives, and the drives' answers (TPDO1, TPDO2, heartbeats) reach the
+//! engine in the next tick, before its deadline. Only the engine's calls are timed (`on_frame`
+//! with `take_immediate`, `tick`, `written`), from a lap after every drive follows its target;
+//! the simulated drives run outside the clock. No stage table in this mode.
 
 use std::hint::black_box;
 use std::time::Duration;
@@ -56,11 +65,102 @@ fn predictor(chain: &ChainConfig) -> Predictor {
         .predictor()
 }
 
-fn engine(chain: &ChainConfig) -> Engine {
-    let settings = chain.validate().expect("chain");
-    let mut e = Engine::new(&settings, predictor(chain), EngineSettings::default(), 0);
+fn engine(chain: &ChainConfig, settings: EngineSettings) -> Engine {
+    let chain_settings = chain.validate().expect("chain");
+    let mut e = Engine::new(&chain_settings, predictor(chain), settings, 0);
     e.validated(0);
     e
+}
+
+/// Every finger on a simulated CiA 402 drive, as `handctl demo --drives cia402` configures them.
+fn cia402_settings() -> EngineSettings {
+    use driver::drive_config::{Drive, Drives};
+    use hand_model::nodes::DriveFingerConfig;
+    let fingers = std::array::from_fn(|f| {
+        let d = DriveFingerConfig::simulated(f).expect("a simulated drive");
+        Drive::Cia402 {
+            node: d.node,
+            mode: hand_canopen::Mode::CyclicSyncTorque,
+            scaling: d.scaling,
+        }
+    });
+    let canopen = driver::drive_config::CanopenConfig::default();
+    EngineSettings {
+        drives: Drives {
+            fingers,
+            master: Some((
+                hand_canopen::NodeId::try_new(canopen.master_node_id).expect("node id"),
+                hand_canopen::CobId::try_new(canopen.sync_cob_id).expect("COB-ID"),
+            )),
+        },
+        ..EngineSettings::default()
+    }
+}
+
+/// The simulated drives beside the engine, outside the timed part.
+struct DriveSims {
+    drives: Vec<hand_canopen::sim::SimDrive>,
+    /// What the drives sent, for the engine's next tick.
+    to_engine: Vec<CanFrame>,
+    /// The engine's frames of this tick (its tick's output and its immediate answers).
+    from_engine: Vec<CanFrame>,
+    scratch: Vec<hand_canopen::CanFrame>,
+}
+
+impl DriveSims {
+    fn new(settings: &EngineSettings) -> Self {
+        let mut scratch = Vec::new();
+        let drives = settings
+            .drives
+            .fingers
+            .iter()
+            .filter_map(|d| match d {
+                driver::drive_config::Drive::Cia402 { node, .. } => {
+                    let mut sim = hand_canopen::sim::SimDrive::new(*node);
+                    sim.power_on(0, &mut scratch);
+                    Some(sim)
+                }
+                driver::drive_config::Drive::Native => None,
+            })
+            .collect();
+        let mut s = Self {
+            drives,
+            to_engine: Vec::with_capacity(64),
+            from_engine: Vec::with_capacity(64),
+            scratch: Vec::with_capacity(64),
+        };
+        s.to_engine.extend(scratch.drain(..).map(to_dbc));
+        s
+    }
+
+    /// The engine's frames reach every drive at `now`; what the drives send goes to the engine
+    /// next.
+    fn exchange(&mut self, now: u64) {
+        for f in self.from_engine.drain(..) {
+            if let Some(c) = hand_canopen::CanFrame::new(f.raw_id() as u16, f.data()) {
+                for d in &mut self.drives {
+                    d.on_frame(&c, now, &mut self.scratch);
+                }
+            }
+        }
+        for d in &mut self.drives {
+            d.poll(now, &mut self.scratch);
+        }
+        self.to_engine.extend(self.scratch.drain(..).map(to_dbc));
+    }
+}
+
+fn to_dbc(f: hand_canopen::CanFrame) -> CanFrame {
+    CanFrame::new_standard(f.cob_id(), f.payload()).expect("an 11-bit CANopen frame")
+}
+
+/// Whether every drive of `engine` follows its target.
+fn drives_enabled(engine: &Engine) -> bool {
+    (0..5).all(|f| {
+        engine
+            .drive_status(f)
+            .is_none_or(|s| matches!(s, hand_canopen::DriveStatus::Running { enabled: true, .. }))
+    })
 }
 
 /// 20 s of traffic from a patient flexing and extending the whole hand, cut into ticks: the
@@ -137,32 +237,91 @@ impl Hist {
     }
 }
 
-/// One replayed tick: the frames of tick `i` of lap `lap`, then `tick` and `written`.
-fn run_tick(engine: &mut Engine, frames: &[(u64, CanFrame)], lap: u64, deadline: u64) -> usize {
+/// One replayed tick: the frames of tick `i` of lap `lap` (and with drives, what they sent
+/// since the last tick, received half a tick before the deadline), then `tick` and `written`.
+fn run_tick(
+    engine: &mut Engine,
+    frames: &[(u64, CanFrame)],
+    lap: u64,
+    deadline: u64,
+    sims: Option<&mut DriveSims>,
+) -> usize {
     for (t, f) in frames {
         engine.on_frame(f, t + SPAN_US * lap);
     }
-    let n = engine.tick(deadline, deadline).len();
+    let Some(sims) = sims else {
+        let n = engine.tick(deadline, deadline).len();
+        engine.written(deadline, 0);
+        return n;
+    };
+    for f in &sims.to_engine {
+        engine.on_frame(f, deadline - TICK_US / 2);
+        sims.from_engine.extend_from_slice(engine.take_immediate());
+    }
+    sims.to_engine.clear();
+    let out = engine.tick(deadline, deadline);
+    let n = out.len();
+    sims.from_engine.extend_from_slice(out);
     engine.written(deadline, 0);
     n
 }
 
-/// The whole tick over `n_ticks` ticks: the histogram and the cost of one timer pair, ns.
-fn whole_ticks(chain: &ChainConfig, ticks: &[Vec<(u64, CanFrame)>], n_ticks: u64) -> (Hist, u64) {
-    let mut engine = engine(chain);
+/// The whole tick over `n_ticks` ticks (with `drives`, every finger on a simulated CiA 402
+/// drive): the histogram and the cost of one timer pair, ns.
+fn whole_ticks(
+    chain: &ChainConfig,
+    ticks: &[Vec<(u64, CanFrame)>],
+    n_ticks: u64,
+    drives: bool,
+) -> (Hist, u64) {
+    let settings = if drives {
+        cia402_settings()
+    } else {
+        EngineSettings::default()
+    };
+    let mut sims = drives.then(|| DriveSims::new(&settings));
+    let mut engine = engine(chain, settings);
     let mut hist = Hist::new();
-    // Warm up one lap, untimed.
-    for (i, frames) in ticks.iter().enumerate() {
-        run_tick(&mut engine, frames, 0, (i as u64 + 1) * TICK_US);
+    // Warm up one lap, untimed (and with drives, until every drive follows its target).
+    let mut warm_laps = 0;
+    loop {
+        for (i, frames) in ticks.iter().enumerate() {
+            let deadline = SPAN_US * warm_laps + (i as u64 + 1) * TICK_US;
+            run_tick(&mut engine, frames, warm_laps, deadline, sims.as_mut());
+            if let Some(s) = sims.as_mut() {
+                s.exchange(deadline);
+            }
+        }
+        warm_laps += 1;
+        if drives_enabled(&engine) {
+            break;
+        }
+        assert!(
+            warm_laps < 3,
+            "the drives did not all start in {warm_laps} laps"
+        );
     }
     for k in 0..n_ticks {
-        let lap = 1 + k / ticks.len() as u64;
+        let lap = warm_laps + k / ticks.len() as u64;
         let i = (k % ticks.len() as u64) as usize;
         let deadline = SPAN_US * lap + (i as u64 + 1) * TICK_US;
         let start = ThreadTime::now();
-        black_box(run_tick(&mut engine, &ticks[i], lap, deadline));
+        black_box(run_tick(
+            &mut engine,
+            &ticks[i],
+            lap,
+            deadline,
+            sims.as_mut(),
+        ));
         hist.record(start.elapsed().as_nanos() as u64);
+        if let Some(s) = sims.as_mut() {
+            s.exchange(deadline);
+        }
     }
+    assert!(
+        drives_enabled(&engine),
+        "a drive stopped following its target during the run"
+    );
     let c = engine.counters();
     eprintln!(
         "engine after {} ticks: {} deadline misses, state {:?}, faults {:?}",
@@ -321,6 +480,42 @@ fn stages(chain_cfg: &ChainConfig, ticks: &[Vec<(u64, CanFrame)>], rounds: usize
     }
 }
 
+/// `--drives cia402`: the tick with five drives, no stage table.
+fn main_cia402(chain: &ChainConfig, json: bool, n_ticks: u64) {
+    // A drive's finger sends no FINGER_STATUS.
+    let ticks: Vec<Vec<(u64, CanFrame)>> = traffic()
+        .into_iter()
+        .map(|t| {
+            t.into_iter()
+                .filter(|(_, f)| {
+                    hand_dbc::messages::FingerStatus::instance_of(f.raw_id()).is_none()
+                })
+                .collect()
+        })
+        .collect();
+    let (hist, timer_ns) = whole_ticks(chain, &ticks, n_ticks, true);
+    let (p50, p99, max, mean) = (
+        hist.quantile_us(0.5),
+        hist.quantile_us(0.99),
+        hist.max_ns as f64 / 1000.0,
+        hist.mean_us(),
+    );
+    if json {
+        println!(
+            "{{\"what\":\"daemon_tick_cia402\",\"impl\":\"handstack\",\"ticks\":{},\"us_cpu_median\":{p50:.2},\"us_cpu_p99\":{p99:.2},\"us_cpu_max\":{max:.2},\"us_cpu_mean\":{mean:.2},\"timer_ns\":{timer_ns}}}",
+            hist.n
+        );
+        return;
+    }
+    println!(
+        "{} ticks with five CiA 402 drives (torque mode), CPU time per tick from a {BIN_NS} ns \
+         histogram:",
+        hist.n
+    );
+    println!("  median {p50:.2} us, p99 {p99:.2} us, max {max:.2} us, mean {mean:.2} us");
+    println!("  (one timer pair costs {timer_ns} ns and is in every tick's figure)");
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let json = args.iter().any(|a| a == "--json");
@@ -331,9 +526,18 @@ fn main() {
         .map(|v| v.parse().expect("--ticks N"))
         .unwrap_or(100_000);
     let chain = ChainConfig::default();
+    match args
+        .iter()
+        .position(|a| a == "--drives")
+        .map(|i| args.get(i + 1).map(String::as_str))
+    {
+        None | Some(Some("native")) => {}
+        Some(Some("cia402")) => return main_cia402(&chain, json, n_ticks),
+        Some(other) => panic!("--drives {other:?}: native or cia402"),
+    }
     let ticks = traffic();
     let frames: usize = ticks.iter().map(Vec::len).sum();
-    let (hist, timer_ns) = whole_ticks(&chain, &ticks, n_ticks);
+    let (hist, timer_ns) = whole_ticks(&chain, &ticks, n_ticks, false);
     let s = stages(&chain, &ticks, 25);
     let (p50, p99, max, mean) = (
         hist.quantile_us(0.5),
