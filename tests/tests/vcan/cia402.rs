@@ -4,15 +4,19 @@
 //! tick sends its RPDO1 followed by SYNC; the drive's TPDO1 comes back. The drive trips (EMCY):
 //! that finger alone gets the quick stop until `handctl arm`, which starts the drive again.
 //! The drive is power-cycled: handd sees its boot-up, holds it in quick stop, never enables it
-//! before `handctl arm`, and after the arm configures it from scratch. Killed, handd stops its heartbeat and the drive stops by itself on its watchdog (EMCY
-//! 0x8130).
+//! before `handctl arm`, and after the arm configures it from scratch. The bus goes off (an
+//! injected bus-off error frame): after the reopen handd holds the drive in quick stop, its
+//! state unknown, and starts it from scratch (reset communication, configuration) only after
+//! `handctl arm`. Killed, handd stops its heartbeat and the drive stops by itself on its
+//! watchdog (EMCY 0x8130).
 
 use std::time::{Duration, Instant};
 
 use hand_dbc::messages::FingerSetpoint;
-use handstack_tests::vcan::monitor::now_us;
+use handstack_tests::vcan::monitor::{now_us, writer};
 use handstack_tests::vcan::procs::handsim;
 use handstack_tests::vcan::{Monitor, TestConfig, VcanEnv};
+use socketcan::Socket;
 
 use super::arming::Armed;
 use super::calibrated_model;
@@ -39,9 +43,12 @@ const WATCHDOG_BAR_US: u64 = 250_000;
 const TRIP_S: f64 = 3.0;
 /// The drive is power-cycled this long after handsim started, s.
 const POWER_CYCLE_S: f64 = 6.5;
+/// NMT from handd: the command byte and the node.
+const NMT: u32 = 0x000;
+const RESET_COMMUNICATION: [u8; 2] = [0x82, 6];
 
-/// Polls `handctl status` until the index drive's line satisfies `ok` (and handd runs, if
-/// `running`), for at most `limit`; the time it took.
+/// Polls `handctl status` until handd runs and the index drive's line satisfies `ok`, for at
+/// most `limit`; the time it took.
 fn wait_drive(
     env: &VcanEnv,
     cfg: &TestConfig,
@@ -49,10 +56,32 @@ fn wait_drive(
     limit: Duration,
     ok: impl Fn(&driver::protocol::DriveLine) -> bool,
 ) -> Duration {
+    wait_status(env, cfg, what, limit, true, ok)
+}
+
+/// [`wait_drive`] in any state of handd's (a latched fault holds it in SAFE).
+fn wait_drive_any(
+    env: &VcanEnv,
+    cfg: &TestConfig,
+    what: &str,
+    limit: Duration,
+    ok: impl Fn(&driver::protocol::DriveLine) -> bool,
+) -> Duration {
+    wait_status(env, cfg, what, limit, false, ok)
+}
+
+fn wait_status(
+    env: &VcanEnv,
+    cfg: &TestConfig,
+    what: &str,
+    limit: Duration,
+    running: bool,
+    ok: impl Fn(&driver::protocol::DriveLine) -> bool,
+) -> Duration {
     let started = Instant::now();
     loop {
         let st = cfg.status(env);
-        if st.state == "RUNNING" && st.drives.first().is_some_and(&ok) {
+        if (!running || st.state == "RUNNING") && st.drives.first().is_some_and(&ok) {
             return started.elapsed();
         }
         assert!(
@@ -87,7 +116,7 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
         &dir,
         "handsim",
         "sine",
-        14.0,
+        18.0,
         &["--cia402", "1", "--fault", &trip, "--fault", &cycle],
     );
     let sim_at = now_us();
@@ -155,6 +184,34 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
     );
     println!(
         "cia402: after the power cycle and `handctl arm` the drive follows again {:.0} ms later",
+        t.as_secs_f64() * 1e3
+    );
+    // Bus-off and its recovery: the drive's state is unknown after it, so handd holds it in
+    // quick stop and starts it from scratch only after `arm`.
+    std::thread::sleep(Duration::from_millis(1_000));
+    let busoff_at = now_us();
+    let busoff = socketcan::CanErrorFrame::new_error(0x0040, &[0; 8]).expect("error frame");
+    writer(&env.iface)
+        .write_frame(&busoff)
+        .expect("vcan accepts an injected error frame");
+    wait_drive_any(
+        &env,
+        &cfg,
+        "the bus-off recovery is seen",
+        Duration::from_secs(4),
+        |d| d.faulted && d.state.contains("bus-off recovery"),
+    );
+    std::thread::sleep(Duration::from_millis(500));
+    let armed3 = Armed::now(&env, &cfg.socket);
+    let t = wait_drive(
+        &env,
+        &cfg,
+        "the drive runs again after the bus-off and arm",
+        Duration::from_secs(4),
+        following,
+    );
+    println!(
+        "cia402: after the bus-off and `handctl arm` the drive follows again {:.0} ms later",
         t.as_secs_f64() * 1e3
     );
     std::thread::sleep(Duration::from_millis(1_000));
@@ -273,8 +330,68 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
         "handd configured the power-cycled drive before `arm`"
     );
     assert!(
-        sdo_after(rearmed.sent_us, kill_at) >= 20,
+        sdo_after(rearmed.sent_us, busoff_at) >= 20,
         "the power-cycled drive was not configured again after `arm`"
+    );
+    // After the bus-off: at most one RPDO1 of Enable operation built before handd read the
+    // error frame, then only quick stops until `arm`; no SDO and no NMT to the drive before
+    // it; after it a reset of the drive's communication and its whole configuration again.
+    let onset = seen
+        .iter()
+        .find(|s| s.frame.is_none() && s.time_us >= busoff_at)
+        .map(|s| s.time_us)
+        .expect("the monitor saw the injected bus-off error frame");
+    let after_off: Vec<_> = frames
+        .iter()
+        .filter(|f| f.1 == RPDO1 && f.0 > onset && f.0 < armed3.sent_us)
+        .collect();
+    let first_stop = after_off
+        .iter()
+        .position(|f| f.2 == QUICK_STOP)
+        .expect("a quick stop after the bus-off");
+    println!(
+        "cia402: after the bus-off, {} RPDO1 in quick stop before `arm` (the first {:.1} ms \
+         after the error frame; {first_stop} built before it was read went first)",
+        after_off.len() - first_stop,
+        (after_off[first_stop].0 - onset) as f64 * 1e-3
+    );
+    assert!(
+        first_stop <= 1 && after_off[first_stop..].iter().all(|f| f.2 == QUICK_STOP),
+        "Enable operation after the bus-off before `arm`: {after_off:?}"
+    );
+    assert!(
+        after_off.len() - first_stop >= 8,
+        "{} quick stops after the bus-off",
+        after_off.len() - first_stop
+    );
+    assert!(
+        after_off[first_stop].0 - onset <= 100_000,
+        "the first quick stop {} us after the bus-off",
+        after_off[first_stop].0 - onset
+    );
+    assert_eq!(
+        sdo_after(onset, armed3.sent_us),
+        0,
+        "handd configured the drive after the bus-off before `arm`"
+    );
+    let resets = |from: u64, to: u64| {
+        frames
+            .iter()
+            .filter(|f| f.1 == NMT && f.2 == RESET_COMMUNICATION && f.0 > from && f.0 < to)
+            .count()
+    };
+    assert_eq!(
+        resets(onset, armed3.sent_us),
+        0,
+        "handd reset the drive after the bus-off before `arm`"
+    );
+    assert!(
+        resets(armed3.sent_us, kill_at) >= 1,
+        "handd did not reset the drive's communication after the bus-off and `arm`"
+    );
+    assert!(
+        sdo_after(armed3.sent_us, kill_at) >= 20,
+        "the drive was not configured again after the bus-off and `arm`"
     );
     let tpdos = last_second(TPDO1);
     assert!(tpdos.len() >= 17, "{} TPDO1 in that second", tpdos.len());
