@@ -250,6 +250,11 @@ pub struct Runner<T: Transport, K: Clock> {
     late: [LateTick; LATE_TICKS_KEPT],
     late_count: u64,
     late_log: LogLimit,
+    /// When the loop's last sleep ended (daemon clock, µs) and the loop thread's CPU time then
+    /// (ns): where a late tick's time went ([`LateTick::asleep_us`], [`LateTick::ran_us`]).
+    /// Zero outside [`Runner::run_realtime`].
+    woke_us: u64,
+    woke_cpu_ns: u64,
 }
 
 impl<T: Transport, K: Clock> Runner<T, K> {
@@ -288,6 +293,8 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             never_opened: false,
             late: [LateTick::default(); LATE_TICKS_KEPT],
             late_count: 0,
+            woke_us: 0,
+            woke_cpu_ns: 0,
             late_log: LogLimit::default(),
         }
     }
@@ -669,12 +676,19 @@ impl<T: Transport, K: Clock> Runner<T, K> {
     #[cold]
     fn note_late(&mut self, deadline: u64, woke: u64, started: u64, frames: u64) {
         let since_deadline = self.clock.now_us().saturating_sub(deadline);
+        let lateness = started.saturating_sub(deadline);
         let late = LateTick {
             deadline_mono_us: crate::rt::monotonic_us().saturating_sub(since_deadline),
             wake_us: woke.saturating_sub(deadline),
             read_us: started.saturating_sub(woke.max(deadline)),
             frames,
             cpu: crate::rt::current_cpu(),
+            asleep_us: self.woke_us.saturating_sub(deadline).min(lateness),
+            ran_us: if self.woke_us == 0 {
+                0
+            } else {
+                crate::rt::thread_cpu_ns().saturating_sub(self.woke_cpu_ns) / 1_000
+            },
         };
         self.late[(self.late_count % LATE_TICKS_KEPT as u64) as usize] = late;
         self.late_count += 1;
@@ -683,6 +697,8 @@ impl<T: Transport, K: Clock> Runner<T, K> {
                 late_us = late.lateness_us(),
                 woke_us = late.wake_us,
                 read_us = late.read_us,
+                asleep_us = late.asleep_us,
+                ran_us = late.ran_us,
                 frames,
                 cpu = late.cpu,
                 left_out,
@@ -783,6 +799,8 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             let wake = self.next_wake_us();
             if wake > now {
                 std::thread::sleep(std::time::Duration::from_micros(wake - now));
+                self.woke_us = self.clock.now_us();
+                self.woke_cpu_ns = crate::rt::thread_cpu_ns();
             }
             if self.clock.now_us() < self.next_deadline_us {
                 self.service_bus();

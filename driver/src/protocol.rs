@@ -174,6 +174,15 @@ pub struct LateTick {
     pub frames: u64,
     /// The CPU the loop ran the tick on.
     pub cpu: u32,
+    /// Of the lateness, how long the loop still slept past the deadline (its timer had expired
+    /// and the kernel had not run it yet: the scheduler, or a machine that did not run), µs.
+    #[serde(default)]
+    pub asleep_us: u64,
+    /// Thread CPU time the loop used from its last wake-up to the tick's start (reading the bus
+    /// between ticks and at the deadline: handd's own work), µs. The rest of the lateness
+    /// after `asleep_us` is time the loop was awake but not running.
+    #[serde(default)]
+    pub ran_us: u64,
 }
 
 impl LateTick {

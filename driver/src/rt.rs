@@ -64,6 +64,12 @@ pub fn monotonic_us() -> u64 {
     t.tv_sec as u64 * 1_000_000 + t.tv_nsec as u64 / 1_000
 }
 
+/// The calling thread's CPU time, ns.
+pub fn thread_cpu_ns() -> u64 {
+    let t = rustix::time::clock_gettime(rustix::time::ClockId::ThreadCPUTime);
+    t.tv_sec as u64 * 1_000_000_000 + t.tv_nsec as u64
+}
+
 /// The CPU the calling thread runs on.
 pub fn current_cpu() -> u32 {
     rustix::thread::sched_getcpu() as u32

@@ -161,13 +161,15 @@ pub fn format_status(s: &Status) -> String {
         for l in &s.late_ticks {
             out += &format!(
                 "  {:>6} us late = woke {:>6} us + read {:>5} us ({} frames), CPU {}, at \
-                 CLOCK_MONOTONIC {:.3} s\n",
+                 CLOCK_MONOTONIC {:.3} s; asleep past the deadline {} us, the loop ran {} us\n",
                 l.lateness_us(),
                 l.wake_us,
                 l.read_us,
                 l.frames,
                 l.cpu,
-                l.deadline_mono_us as f64 / 1e6
+                l.deadline_mono_us as f64 / 1e6,
+                l.asleep_us,
+                l.ran_us
             );
         }
     }
@@ -389,6 +391,8 @@ mod tests {
                 read_us: 1_500,
                 frames: 96,
                 cpu: 1,
+                asleep_us: 26_000,
+                ran_us: 900,
             }],
             ..Status::default()
         };
@@ -396,7 +400,8 @@ mod tests {
         assert!(
             text.contains(
                 "\n   28500 us late = woke  27000 us + read  1500 us (96 frames), CPU 1, at \
-                 CLOCK_MONOTONIC 224.400 s\n"
+                 CLOCK_MONOTONIC 224.400 s; asleep past the deadline 26000 us, the loop ran \
+                 900 us\n"
             ),
             "{text}"
         );

@@ -265,14 +265,16 @@ impl std::fmt::Display for Judged {
             write!(
                 f,
                 "\n  late tick at CLOCK_MONOTONIC {} us on CPU {}: {} us late (woke {} us, read \
-                 {} us, {} frames), {} us of it while CPU {} ran nothing ({} us of that in gaps \
-                 under {} us)",
+                 {} us, {} frames; asleep past the deadline {} us, handd's loop ran {} us), {} \
+                 us of it while CPU {} ran nothing ({} us of that in gaps under {} us)",
                 t.deadline_mono_us,
                 t.cpu,
                 t.lateness_us(),
                 t.wake_us,
                 t.read_us,
                 t.frames,
+                t.asleep_us,
+                t.ran_us,
                 t.lateness_us() - uncovered,
                 t.cpu,
                 self.stalls
@@ -295,6 +297,7 @@ mod tests {
             read_us: 1_000,
             frames: 40,
             cpu,
+            ..LateTick::default()
         }
     }
 
