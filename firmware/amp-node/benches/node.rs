@@ -1,6 +1,7 @@
 //! Per-sample cost of the node core on the host: `AmpNode::on_frames` (12 conversions, three
 //! EMG frames encoded and protected, the status every 100th period) and `AmpNode::drain` into
-//! a controller that takes every frame. `cargo bench -p amp-node --bench node`.
+//! a controller that takes every frame; and the same per conversion at 2 kSPS with the
+//! decimating FIR. `cargo bench -p amp-node --bench node`.
 
 #![allow(
     missing_docs,
@@ -10,7 +11,7 @@
 use std::hint::black_box;
 
 use ads1299::{Code, Frame, Gain, LeadOff, Status};
-use amp_node::{AmpNode, NodeSettings};
+use amp_node::{AmpNode, NodeRate, NodeSettings};
 use criterion::{criterion_group, criterion_main, Criterion};
 use hand_dbc::CanFrame;
 
@@ -46,20 +47,31 @@ fn frames(i: i32) -> (Frame, Frame) {
 }
 
 fn bench(c: &mut Criterion) {
-    let settings = NodeSettings::try_new(Gain::X8, LeadOff::Dc6nA).expect("settings");
-    let mut node: AmpNode = AmpNode::new(&settings);
-    let mut sink = Sink(0);
     let inputs: Vec<(Frame, Frame)> = (0..1000).map(frames).collect();
-    let mut k = 0;
-    c.bench_function("amp_node sample (on_frames + drain)", |b| {
-        b.iter(|| {
-            let (a, bb) = &inputs[k % inputs.len()];
-            k += 1;
-            black_box(node.on_frames(black_box(a), black_box(bb)));
-            node.drain(&mut sink);
-        })
-    });
-    black_box(sink.0);
+    for (rate, name) in [
+        (NodeRate::Sps1000, "amp_node sample (on_frames + drain)"),
+        // Per conversion at 2 kSPS: every second one runs the 63-tap FIR on 12 channels and
+        // encodes the sample; a bus sample costs two of these.
+        (
+            NodeRate::Sps2000Decimated,
+            "amp_node conversion at 2 kSPS (on_frames + drain)",
+        ),
+    ] {
+        let settings =
+            NodeSettings::try_with_rate(rate, Gain::X8, LeadOff::Dc6nA).expect("settings");
+        let mut node: AmpNode = AmpNode::new(&settings);
+        let mut sink = Sink(0);
+        let mut k = 0;
+        c.bench_function(name, |b| {
+            b.iter(|| {
+                let (a, bb) = &inputs[k % inputs.len()];
+                k += 1;
+                black_box(node.on_frames(black_box(a), black_box(bb)));
+                node.drain(&mut sink);
+            })
+        });
+        black_box(sink.0);
+    }
 }
 
 criterion_group!(benches, bench);

@@ -2,7 +2,8 @@
 //! hand.dbc's EMG frames out over any [`embedded_can::nb::Can`].
 //!
 //! - [`NodeSettings`]: the node's configuration, validated once: the two chips' register
-//!   settings and the bus scale.
+//!   settings, the bus scale and the chips' rate ([`NodeRate`]).
+//! - [`Decimator`]: at 2 kSPS, the FIR that takes each pair of conversions to one bus sample.
 //! - [`BusScale`]: ADS1299 codes to the bus's 2.5 uV LSB, exact integer arithmetic.
 //! - [`AmpNode`]: per sample, the two data frames become EMG_SAMPLES_G0..G2 (8-bit sample
 //!   counter and CRC through `hand-dbc-core`, the daemon's own codec) in a fixed transmit
@@ -16,12 +17,14 @@
 
 #![cfg_attr(not(test), no_std)]
 
+mod decimator;
 mod node;
 mod settings;
 mod tx_queue;
 mod units;
 
+pub use decimator::{Decimator, TAPS, TAPS_Q15};
 pub use node::{AmpNode, NodeCounters, SampleOutcome, CHANNELS, STATUS_EVERY};
-pub use settings::{NodeSettings, NodeSettingsError};
+pub use settings::{NodeRate, NodeSettings, NodeSettingsError};
 pub use tx_queue::TxQueue;
 pub use units::{BusSample, BusScale, VREF_UV};

@@ -1,7 +1,7 @@
 //! The node core: one call per conversion, frames into the queue, the queue into the CAN
 //! controller.
 
-use ads1299::{Ads1299, Error, Frame};
+use ads1299::{Ads1299, Code, Error, Frame};
 use embedded_can::nb::Can;
 use embedded_can::Frame as _;
 use embedded_hal::spi::SpiDevice;
@@ -9,7 +9,8 @@ use hand_dbc_core::e2e::E2eProtector;
 use hand_dbc_core::messages::{AmpState, EmgSamplesG0, EmgSamplesG1, EmgSamplesG2, EmgStatus};
 use hand_dbc_core::CanFrame;
 
-use crate::{BusScale, NodeSettings, TxQueue};
+use crate::decimator::ZERO;
+use crate::{BusScale, Decimator, NodeRate, NodeSettings, TxQueue};
 
 /// EMG channels on the bus: the first chip's 8, then the second chip's channels 1..4.
 pub const CHANNELS: usize = 12;
@@ -32,15 +33,20 @@ pub enum SampleOutcome {
     /// advanced).
     Dropped,
     /// The chips could not be read (SPI error or bad status header): no sample (counted,
-    /// counter advanced).
+    /// counter advanced). At 2 kSPS: a failed read of either conversion of a pair.
     ReadError,
+    /// At 2 kSPS, the first conversion of a pair: taken into the decimator, nothing queued.
+    Filtering,
 }
 
 /// What the node counted since it started.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct NodeCounters {
-    /// Sample periods (every call of [`AmpNode::on_frames`] or [`AmpNode::on_read_error`]).
+    /// Bus sample periods (at 1 kSPS every call of [`AmpNode::on_frames`] or
+    /// [`AmpNode::on_read_error`]; at 2 kSPS every second one).
     pub periods: u64,
+    /// Conversions (every call of [`AmpNode::on_frames`] or [`AmpNode::on_read_error`]).
+    pub conversions: u64,
     /// Samples whose frames were queued.
     pub queued: u64,
     /// Samples dropped because the transmit queue was full.
@@ -74,6 +80,12 @@ pub struct AmpNode<const Q: usize = 12> {
     faults: u8,
     since_status: u16,
     counters: NodeCounters,
+    /// At 2 kSPS: the FIR, the last conversion read (held into the FIR for one that could
+    /// not be read), saturation codes and a failed read within the current pair.
+    decimator: Option<Decimator<CHANNELS>>,
+    last: [Code; CHANNELS],
+    pair_saturation: u16,
+    pair_failed: bool,
 }
 
 impl<const Q: usize> AmpNode<Q> {
@@ -95,6 +107,13 @@ impl<const Q: usize> AmpNode<Q> {
             faults: 0,
             since_status: 0,
             counters: NodeCounters::default(),
+            decimator: match settings.rate() {
+                NodeRate::Sps1000 => None,
+                NodeRate::Sps2000Decimated => Some(Decimator::new()),
+            },
+            last: [ZERO; CHANNELS],
+            pair_saturation: 0,
+            pair_failed: false,
         }
     }
 
@@ -142,24 +161,46 @@ impl<const Q: usize> AmpNode<Q> {
         }
     }
 
-    /// One sample period's data frames (first chip, second chip): the bus values, the three
-    /// EMG frames queued (or the sample dropped whole), the status when due.
+    /// One conversion's data frames (first chip, second chip): the bus values, the three
+    /// EMG frames queued (or the sample dropped whole), the status when due. At 2 kSPS every
+    /// second call does that, on the decimator's output; the first of a pair is
+    /// [`SampleOutcome::Filtering`].
     pub fn on_frames(&mut self, first: &Frame, second: &Frame) -> SampleOutcome {
-        let mut raw = [0i16; CHANNELS];
-        for (c, r) in raw.iter_mut().enumerate() {
-            let code = if c < 8 {
+        self.counters.conversions += 1;
+        let mut codes = [ZERO; CHANNELS];
+        for (c, code) in codes.iter_mut().enumerate() {
+            *code = if c < 8 {
                 first.codes[c]
             } else {
                 second.codes[c - 8]
             };
+        }
+        self.lead_off |=
+            u16::from(first.status.lead_off()) | (u16::from(second.status.lead_off() & 0x0F) << 8);
+        if let Some(d) = &mut self.decimator {
+            self.last = codes;
+            for (c, code) in codes.iter().enumerate() {
+                if code.is_saturated() {
+                    self.pair_saturation |= 1 << c;
+                }
+            }
+            match d.push(&codes) {
+                None => return SampleOutcome::Filtering,
+                Some(out) => codes = out,
+            }
+            self.saturation |= core::mem::take(&mut self.pair_saturation);
+            if core::mem::take(&mut self.pair_failed) {
+                return self.period_lost();
+            }
+        }
+        let mut raw = [0i16; CHANNELS];
+        for (c, (r, code)) in raw.iter_mut().zip(codes).enumerate() {
             let v = self.scale.to_bus(code);
             *r = v.raw;
             if v.clipped {
                 self.saturation |= 1 << c;
             }
         }
-        self.lead_off |=
-            u16::from(first.status.lead_off()) | (u16::from(second.status.lead_off() & 0x0F) << 8);
         let outcome = match self.emg_frames(&raw) {
             Some(frames) if self.queue.free() >= frames.len() => {
                 for f in frames {
@@ -178,9 +219,25 @@ impl<const Q: usize> AmpNode<Q> {
         outcome
     }
 
-    /// A sample period whose chips could not be read: no frames, counter advanced, ADC fault
-    /// on the next status.
+    /// A conversion whose chips could not be read: no frames, counter advanced, ADC fault on
+    /// the next status. At 2 kSPS the last conversion read is held into the decimator in its
+    /// place (its history stays in step), and the pair's bus sample is not sent.
     pub fn on_read_error(&mut self) -> SampleOutcome {
+        self.counters.conversions += 1;
+        self.faults |= FAULT_ADC;
+        if let Some(d) = &mut self.decimator {
+            if d.push(&self.last).is_none() {
+                self.pair_failed = true;
+                return SampleOutcome::ReadError;
+            }
+            self.pair_failed = false;
+            self.saturation |= core::mem::take(&mut self.pair_saturation);
+        }
+        self.period_lost()
+    }
+
+    /// A bus period without a sample.
+    fn period_lost(&mut self) -> SampleOutcome {
         self.faults |= FAULT_ADC;
         self.end_period();
         SampleOutcome::ReadError
