@@ -53,7 +53,8 @@ fn the_chips_run_at_2_ksps_and_the_bus_at_1_khz() {
     for chip in [s.first_chip(), s.second_chip()] {
         assert_eq!(chip.data_rate(), ads1299::DataRate::Sps2000);
     }
-    // CONFIG1 (SBAS499C, "CONFIG1: Configuration Register 1"): DR[2:0] = 011 for 2 kSPS; the first chip drives CLK.
+    // CONFIG1 (SBAS499C, "CONFIG1: Configuration Register 1"): DR[2:0] = 011 for 2 kSPS;
+    // the first chip drives CLK.
     assert_eq!(s.first_chip().block_a()[0], 0xF3);
     assert_eq!(s.second_chip().block_a()[0], 0xD3);
     assert_eq!(

@@ -59,17 +59,7 @@ fn wait_drive(
     wait_status(env, cfg, what, limit, true, ok)
 }
 
-/// [`wait_drive`] in any state of handd's (a latched fault holds it in SAFE).
-fn wait_drive_any(
-    env: &VcanEnv,
-    cfg: &TestConfig,
-    what: &str,
-    limit: Duration,
-    ok: impl Fn(&driver::protocol::DriveLine) -> bool,
-) -> Duration {
-    wait_status(env, cfg, what, limit, false, ok)
-}
-
+/// [`wait_drive`], in any state of handd's unless `running` (a latched fault holds it in SAFE).
 fn wait_status(
     env: &VcanEnv,
     cfg: &TestConfig,
@@ -194,11 +184,12 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
     writer(&env.iface)
         .write_frame(&busoff)
         .expect("vcan accepts an injected error frame");
-    wait_drive_any(
+    wait_status(
         &env,
         &cfg,
         "the bus-off recovery is seen",
         Duration::from_secs(4),
+        false,
         |d| d.faulted && d.state.contains("bus-off recovery"),
     );
     std::thread::sleep(Duration::from_millis(500));
