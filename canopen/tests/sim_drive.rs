@@ -7,7 +7,7 @@ use hand_canopen::emcy::{Emcy, ErrorClass};
 use hand_canopen::pdo::{finger_pdos, Direction};
 use hand_canopen::sdo::{SdoClient, SdoError};
 use hand_canopen::sim::{EMCY_HEARTBEAT, EMCY_PDO_LENGTH, SIM_SUPPORTED_MODES};
-use hand_canopen::startup::{Step, StepFailure};
+use hand_canopen::startup::{Step, StepFailure, MAX_BOOT_UPS_DURING_STARTUP};
 use hand_canopen::{
     AbortCode, Mode, NmtState, ObjectAddr, PowerState, StartupStatus, Statusword, SyncProducer,
 };
@@ -290,4 +290,87 @@ fn a_boot_up_from_before_the_reset_is_not_taken_as_its_answer() {
         b.startup.status(),
         StartupStatus::Running(Step::ReadIdentity(1))
     );
+}
+
+/// The start-up up to its first SDO request (the identity's vendor), which is left in flight;
+/// the drive then boots again: its boot-up message.
+fn booted_during_the_identity_read() -> (Bench, hand_canopen::CanFrame) {
+    let mut b = Bench::new(settings(Mode::CyclicSyncTorque));
+    let mut out = Vec::new();
+    b.drive.power_on(0, &mut out);
+    let reset = b.startup.poll(1_000).expect("the reset communication");
+    b.now = 1_000;
+    b.send(reset);
+    // The drive's answer, at its next poll.
+    while b.startup.status() == StartupStatus::Running(Step::AwaitBootUp) {
+        b.now += 1_000;
+        assert!(b.now < 100_000, "no boot-up answered the reset");
+        assert!(b.startup.poll(b.now).is_none());
+        let mut out = Vec::new();
+        b.drive.poll(b.now, &mut out);
+        for f in out {
+            assert!(b.startup.on_frame(&f, b.now).is_none());
+        }
+    }
+    assert_eq!(
+        b.startup.status(),
+        StartupStatus::Running(Step::ReadIdentity(1))
+    );
+    let request = b.startup.poll(b.now).expect("the identity's SDO upload");
+    assert_eq!(request.cob_id(), 0x600 + u16::from(DRIVE));
+    let mut out = Vec::new();
+    b.now += 500;
+    b.drive.power_on(b.now, &mut out);
+    (b, out[0])
+}
+
+/// A drive powered on while handd starts answers the reset with a second boot-up, which can
+/// come while handd already reads its identity (seen on vcan with five drives): the start-up
+/// begins again after that boot-up and ends with the configuration written.
+#[test]
+fn a_boot_up_during_the_start_up_starts_it_again_after_the_boot_up() {
+    let (mut b, boot_up) = booted_during_the_identity_read();
+    assert!(b.startup.on_frame(&boot_up, b.now).is_none());
+    assert_eq!(
+        b.startup.status(),
+        StartupStatus::Running(Step::ReadIdentity(1))
+    );
+    b.run_startup(2_000_000);
+    let status = b.startup.status();
+    assert!(
+        matches!(status, StartupStatus::Done { .. }),
+        "start-up did not finish after the second boot-up: {status:?}"
+    );
+    assert_eq!(b.drive.power_state(), PowerState::OperationEnabled);
+    let s = settings(Mode::CyclicSyncTorque);
+    assert_eq!(
+        b.drive.od().get(ObjectAddr::new(0x1016, 1)),
+        (u32::from(MASTER) << 16) | u32::from(s.master_heartbeat_timeout_ms)
+    );
+}
+
+/// A drive that keeps rebooting during its start-up fails it, the step named.
+#[test]
+fn a_drive_that_keeps_booting_during_its_start_up_fails_it() {
+    let (mut b, boot_up) = booted_during_the_identity_read();
+    for n in 1..=MAX_BOOT_UPS_DURING_STARTUP {
+        b.now += 1_000;
+        b.startup.on_frame(&boot_up, b.now);
+        assert_eq!(
+            b.startup.status(),
+            StartupStatus::Running(Step::ReadIdentity(1)),
+            "after boot-up {n}"
+        );
+    }
+    b.now += 1_000;
+    b.startup.on_frame(&boot_up, b.now);
+    let StartupStatus::Failed(e) = b.startup.status() else {
+        panic!(
+            "still running after {} boot-ups",
+            MAX_BOOT_UPS_DURING_STARTUP + 1
+        );
+    };
+    assert_eq!(e.step, Step::ReadIdentity(1));
+    assert_eq!(e.cause, StepFailure::UnexpectedBootUp);
+    assert!(e.to_string().contains("kept booting"), "{e}");
 }

@@ -101,6 +101,11 @@ impl SdoClient {
         }
     }
 
+    /// Forgets the transfer in flight, if any: its server rebooted and will not answer it.
+    pub fn cancel(&mut self) {
+        self.pending = None;
+    }
+
     /// The server node.
     pub fn node(&self) -> NodeId {
         self.node

@@ -37,10 +37,20 @@ pub enum StepFailure {
     /// The power state machine did not reach Operation enabled.
     #[error(transparent)]
     Cia402(#[from] Cia402Error),
-    /// The drive booted again during its start-up.
-    #[error("the drive sent a boot-up message during start-up")]
+    /// The drive booted again during its start-up, more often than
+    /// [`MAX_BOOT_UPS_DURING_STARTUP`].
+    #[error(
+        "the drive kept booting during start-up ({} boot-ups after the one answering the reset)",
+        MAX_BOOT_UPS_DURING_STARTUP + 1
+    )]
     UnexpectedBootUp,
 }
+
+/// Boot-ups after the answer to the reset that start the start-up again (after the boot-up)
+/// before a further one fails it. A drive powered on while handd starts sends its power-on
+/// boot-up and then answers handd's reset with a second one, which may come while handd
+/// already reads its identity; one that keeps rebooting (a brown-out) is a fault.
+pub const MAX_BOOT_UPS_DURING_STARTUP: u8 = 3;
 
 /// A failed start-up: the drive, the step, the reason.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Error)]
@@ -112,6 +122,8 @@ pub struct Startup {
     /// When the reset communication went out: only a boot-up received after it answers it
     /// (one sent before, at the drive's power-on, may still be queued).
     reset_sent_us: u64,
+    /// Boot-ups that started it again after the one that answered the reset.
+    reboots: u8,
 }
 
 fn masked_equal(expected: SdoData, got: SdoData) -> bool {
@@ -140,6 +152,7 @@ impl Startup {
             supported_modes: 0,
             failed: None,
             reset_sent_us: 0,
+            reboots: 0,
         }
     }
 
@@ -170,6 +183,28 @@ impl Startup {
             step,
             cause,
         });
+    }
+
+    /// The drive booted during the start-up, after the boot-up that answered the reset: what
+    /// was written is gone and any transfer in flight with it. Start again at the step after
+    /// the boot-up (the drive is freshly booted, pre-operational), a few times at most.
+    fn booted_again(&mut self, step: Step) {
+        if self.reboots >= MAX_BOOT_UPS_DURING_STARTUP {
+            self.fail(step, StepFailure::UnexpectedBootUp);
+            return;
+        }
+        self.reboots += 1;
+        let after_boot_up = self
+            .steps
+            .iter()
+            .position(|s| *s == Step::AwaitBootUp)
+            .map_or(0, |i| i + 1);
+        self.at = after_boot_up;
+        self.phase = Phase::Issue;
+        self.sdo.cancel();
+        self.power = PowerDriver::new(self.step_timeout_us);
+        self.identity = Identity::default();
+        self.supported_modes = 0;
     }
 
     fn next_step(&mut self) {
@@ -252,7 +287,7 @@ impl Startup {
                         self.next_step();
                     }
                 } else if self.at > 1 {
-                    self.fail(step, StepFailure::UnexpectedBootUp);
+                    self.booted_again(step);
                 }
             }
             return None;

@@ -7,7 +7,9 @@ pub mod machine;
 pub mod settings;
 pub mod step;
 
-pub use machine::{Identity, Startup, StartupError, StartupStatus, StepFailure};
+pub use machine::{
+    Identity, Startup, StartupError, StartupStatus, StepFailure, MAX_BOOT_UPS_DURING_STARTUP,
+};
 pub use settings::{
     interpolation_period, SettingsError, StartupSettings, ABORT_CONNECTION_QUICK_STOP,
     QUICK_STOP_RAMP_THEN_DISABLE,
