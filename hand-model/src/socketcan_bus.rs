@@ -72,7 +72,6 @@ impl SocketCanBus {
         use socketcan::SocketOptions;
         let set = match listens {
             Listens::Nothing => bus.socket.set_filter_drop_all(),
-            Listens::Everything => bus.socket.set_filter_accept_all(),
             Listens::To(ids) => {
                 // Standard ids, exactly: the mask covers the 11 id bits and the extended-frame
                 // flag, so an extended frame with the same low bits does not pass.
@@ -81,6 +80,21 @@ impl SocketCanBus {
                     .map(|&id| (id, libc_can::SFF_MASK | libc_can::EFF_FLAG))
                     .collect();
                 bus.socket.set_filters(&filters)
+            }
+            Listens::Except(ids) => {
+                // Joined: a frame passes when it matches every filter, each inverted on one id.
+                let filters: Vec<socketcan::CanFilter> = ids
+                    .iter()
+                    .map(|&id| {
+                        socketcan::CanFilter::new_inverted(
+                            id,
+                            libc_can::SFF_MASK | libc_can::EFF_FLAG,
+                        )
+                    })
+                    .collect();
+                bus.socket
+                    .set_join_filters(true)
+                    .and_then(|()| bus.socket.set_filters(&filters))
             }
         };
         set.map_err(|source| SocketBusError::Open {

@@ -4,7 +4,10 @@
 //! Each node has its own bus handle (an endpoint of a [`crate::bus::MemBus`], or its own
 //! SocketCAN socket), exactly as separate ECUs would, so every frame crosses the bus.
 
-use hand_dbc::messages::{CalibrationCue, FingerSetpoint, FingerStatus, HandEstop};
+use hand_dbc::messages::{
+    CalibrationCue, EmgSamplesG0, EmgSamplesG1, EmgSamplesG2, FingerSetpoint, FingerStatus,
+    HandEstop,
+};
 
 use crate::error::SimError;
 use crate::faults::FaultPlan;
@@ -97,17 +100,24 @@ pub enum Listens {
     Nothing,
     /// These ids only.
     To(&'static [u32]),
-    /// Every frame (a CANopen drive, whose ids depend on its node id).
-    Everything,
+    /// Every standard frame but these ids.
+    Except(&'static [u32]),
 }
 
 impl Listens {
+    /// A simulated CiA 402 drive: every frame but the EMG samples (3000 a second, which no
+    /// drive reads). Its ids follow its node id and its SYNC follows its 0x1005, so it takes
+    /// the rest. On `vcan0` five drives each copying every EMG frame too fell behind, and the
+    /// kernel dropped frames from their full receive queues, handd's heartbeat among them.
+    pub const DRIVE: Listens =
+        Listens::Except(&[EmgSamplesG0::ID, EmgSamplesG1::ID, EmgSamplesG2::ID]);
+
     /// Whether a frame with standard id `id` is one the node reads.
     pub fn accepts(self, id: u32) -> bool {
         match self {
             Listens::Nothing => false,
             Listens::To(ids) => ids.contains(&id),
-            Listens::Everything => true,
+            Listens::Except(ids) => !ids.contains(&id),
         }
     }
 }
@@ -177,7 +187,7 @@ impl<B: Bus> World<B> {
             if let Some(d) = cfg.drives[f] {
                 let mut node = DriveFingerNode::try_new(f, cfg.finger, d, cfg.start_us)?;
                 node.set_faults(cfg.faults.clone());
-                drives.push((node, open(Listens::Everything)?));
+                drives.push((node, open(Listens::DRIVE)?));
             } else if cfg.nodes.fingers & (1 << f) != 0 {
                 let mut node = FingerNode::try_new(f, cfg.finger, cfg.start_us)?;
                 node.set_faults(cfg.faults.clone());

@@ -148,3 +148,18 @@ fn the_cued_patient_behaves_the_same_behind_its_filter() {
         "{most} {most_filtered}"
     );
 }
+
+/// A simulated drive's filter passes every frame a CANopen node may need, wherever handd puts
+/// SYNC and whatever the node id, and none of the EMG samples.
+#[test]
+fn a_drives_filter_passes_everything_but_the_emg_samples() {
+    use hand_dbc::messages::{EmgSamplesG0, EmgSamplesG1, EmgSamplesG2};
+    let emg = [EmgSamplesG0::ID, EmgSamplesG1::ID, EmgSamplesG2::ID];
+    for &id in ALL_IDS {
+        assert_eq!(
+            Listens::DRIVE.accepts(id),
+            !emg.contains(&id),
+            "a drive's filter and id {id:#05x}"
+        );
+    }
+}
