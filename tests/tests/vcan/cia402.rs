@@ -12,6 +12,7 @@
 
 use std::time::{Duration, Instant};
 
+use driver::protocol::DriveLine;
 use hand_dbc::messages::FingerSetpoint;
 use handstack_tests::vcan::monitor::{now_us, writer};
 use handstack_tests::vcan::procs::handsim;
@@ -29,16 +30,16 @@ const DRIVE_TABLE: &str = "\n[fingers.index.drive]\nprofile = \"cia402\"\nnode_i
 const RPDO1: u32 = 0x206;
 const TPDO1: u32 = 0x186;
 const EMCY: u32 = 0x086;
-const SYNC: u32 = 0x07F;
+pub(super) const SYNC: u32 = 0x07F;
 /// SDO requests to the drive.
 const SDO_RX: u32 = 0x606;
 /// RPDO1 of the quick stop: controlword 0x0002, target 0.
-const QUICK_STOP: [u8; 4] = [0x02, 0x00, 0x00, 0x00];
+pub(super) const QUICK_STOP: [u8; 4] = [0x02, 0x00, 0x00, 0x00];
 /// The drive's heartbeat and boot-up (`00`).
 const BOOT_UP: u32 = 0x706;
 /// The drive watches handd's heartbeat for three ticks (150 ms); its heartbeat came at most one
 /// tick before the kill, and the EMCY needs a frame time: 250 ms is the bar.
-const WATCHDOG_BAR_US: u64 = 250_000;
+pub(super) const WATCHDOG_BAR_US: u64 = 250_000;
 /// The drive trips this long after handsim started, s.
 const TRIP_S: f64 = 3.0;
 /// The drive is power-cycled this long after handsim started, s.
@@ -54,7 +55,7 @@ fn wait_drive(
     cfg: &TestConfig,
     what: &str,
     limit: Duration,
-    ok: impl Fn(&driver::protocol::DriveLine) -> bool,
+    ok: impl Fn(&DriveLine) -> bool,
 ) -> Duration {
     wait_status(env, cfg, what, limit, true, ok)
 }
@@ -66,21 +67,47 @@ fn wait_status(
     what: &str,
     limit: Duration,
     running: bool,
-    ok: impl Fn(&driver::protocol::DriveLine) -> bool,
+    ok: impl Fn(&DriveLine) -> bool,
 ) -> Duration {
+    wait_drives(env, cfg, what, limit, running, |d| {
+        d.first().is_some_and(&ok)
+    })
+}
+
+/// Polls `handctl status` until every drive's line together satisfies `ok` (and handd runs, if
+/// `running`), for at most `limit`; the time it took.
+pub(super) fn wait_drives(
+    env: &VcanEnv,
+    cfg: &TestConfig,
+    what: &str,
+    limit: Duration,
+    running: bool,
+    ok: impl Fn(&[DriveLine]) -> bool,
+) -> Duration {
+    poll_drives(env, cfg, what, limit, running, ok).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// [`wait_drives`], with the timeout as an error: what was asked and the last status seen.
+pub(super) fn poll_drives(
+    env: &VcanEnv,
+    cfg: &TestConfig,
+    what: &str,
+    limit: Duration,
+    running: bool,
+    ok: impl Fn(&[DriveLine]) -> bool,
+) -> Result<Duration, String> {
     let started = Instant::now();
     loop {
         let st = cfg.status(env);
-        if (!running || st.state == "RUNNING") && st.drives.first().is_some_and(&ok) {
-            return started.elapsed();
+        if (!running || st.state == "RUNNING") && ok(&st.drives) {
+            return Ok(started.elapsed());
         }
-        assert!(
-            started.elapsed() < limit,
-            "{what}: not within {limit:?}: state {}, faults {}, drives {:?}",
-            st.state,
-            st.faults,
-            st.drives
-        );
+        if started.elapsed() >= limit {
+            return Err(format!(
+                "{what}: not within {limit:?}: state {}, faults {}, drives {:?}",
+                st.state, st.faults, st.drives
+            ));
+        }
         std::thread::sleep(Duration::from_millis(50));
     }
 }
@@ -110,8 +137,7 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
         &["--cia402", "1", "--fault", &trip, "--fault", &cycle],
     );
     let sim_at = now_us();
-    let following =
-        |d: &driver::protocol::DriveLine| d.state.starts_with("Operation enabled, following");
+    let following = |d: &DriveLine| d.state.starts_with("Operation enabled, following");
     let t = wait_drive(
         &env,
         &cfg,

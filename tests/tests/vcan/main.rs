@@ -9,6 +9,7 @@
 mod arming;
 mod calibrate;
 mod cia402;
+mod cia402_hand;
 mod clock_step;
 mod deploy;
 mod deploy_safety;

@@ -1,0 +1,271 @@
+//! Issue 26's drills with the whole hand on CiA 402 drives over SocketCAN: every finger moved by
+//! a simulated drive (`handsim --drives cia402`, nodes 5-9, cyclic synchronous torque), none by
+//! a native controller. handd starts all five, the patient tracks the sine with the index finger
+//! (closed loop, R² from the index drive's own TPDO1 torque), then the ring finger's drive trips
+//! (EMCY 0x2310): that finger alone gets the quick stop while the other four keep following.
+//! Killed, handd stops its heartbeat and every drive stops by itself on its watchdog.
+
+use std::time::Duration;
+
+use hand_dbc::messages::FingerSetpoint;
+use hand_model::nodes::DriveFingerConfig;
+use hand_model::patient::{Target, TrackingConfig};
+use handstack_tests::vcan::monitor::now_us;
+use handstack_tests::vcan::procs::handsim;
+use handstack_tests::vcan::{scenario_start_us, Monitor, TestConfig, VcanEnv};
+
+use super::calibrated_model;
+use super::cia402::{poll_drives, wait_drives, QUICK_STOP, SYNC, WATCHDOG_BAR_US};
+
+/// The tripped finger (the ring's drive, node 8).
+const TRIPPED: usize = 3;
+/// The tracked finger (the index's drive, node 6).
+const TRACKED: usize = 1;
+/// The ring's drive trips this long after handsim started, s.
+const TRIP_S: f64 = 13.0;
+/// handsim's run, s (handd is killed before its end, so the drives' watchdogs are seen).
+const RUN_S: f64 = 22.0;
+/// The tracking is scored from this long after every drive follows its setpoint (the native
+/// closed loop's settling from the scenario's start, where its fingers follow at once).
+const SETTLE_US: u64 = 4_000_000;
+/// The CiA 402 state line of a drive that follows its setpoint.
+const FOLLOWING: &str = "Operation enabled, following";
+
+fn node(f: usize) -> u32 {
+    u32::from(hand_model::nodes::drive::simulated_node_id(f))
+}
+
+/// handd.toml's `[fingers.NAME.drive]` for each of the five simulated drives, as a technician
+/// writes them for `handsim --drives cia402` (its scaling and node 5 + finger).
+fn drive_tables() -> String {
+    let s = DriveFingerConfig::SIM_SCALING;
+    let mut t = String::new();
+    for (f, name) in hand_dbc::hand::FINGER_NAMES.iter().enumerate() {
+        t.push_str(&format!(
+            "\n[fingers.{name}.drive]\nprofile = \"cia402\"\nnode_id = {}\nmode = \"cst\"\n\
+             rated_torque_mnm = {:?}\ngear_ratio = {:?}\nmoment_arm_m = {:?}\n\
+             max_torque_permille = {}\nmax_speed_rpm = {}\n",
+            node(f),
+            s.rated_torque_mnm,
+            s.gear_ratio,
+            s.moment_arm_m,
+            s.max_torque_permille,
+            s.max_speed_rpm
+        ));
+    }
+    t.push_str("\n[canopen]\nmaster_node_id = 127\nsync_cob_id = 0x07F\n");
+    t
+}
+
+#[test]
+fn j_every_finger_on_a_drive_tracks_one_trips_alone_and_all_stop_on_their_watchdogs() {
+    let env = VcanEnv::get();
+    let model = calibrated_model(&env).to_path_buf();
+    let dir = env.scratch("cia402-hand");
+    let cfg = TestConfig::write(&env, &dir, &model, 100);
+    let mut text = std::fs::read_to_string(&cfg.path).expect("read the config");
+    text.push_str(&drive_tables());
+    std::fs::write(&cfg.path, text).expect("write the config");
+    let monitor = Monitor::start(&env.iface);
+    let mut handd = cfg.start(&env, &dir);
+    let trip = format!("drive-trip:{TRIPPED}@{TRIP_S}..{}", TRIP_S + 0.1);
+    let mut sim = handsim(
+        &env,
+        &dir,
+        "handsim",
+        "sine",
+        RUN_S,
+        &["--drives", "cia402", "--fault", &trip],
+    );
+    let all_follow = |d: &[driver::protocol::DriveLine]| {
+        d.len() == 5 && d.iter().all(|l| l.state.starts_with(FOLLOWING))
+    };
+    let t = wait_drives(
+        &env,
+        &cfg,
+        "all five drives follow",
+        Duration::from_secs(6),
+        true,
+        all_follow,
+    );
+    let following_at = now_us();
+    println!(
+        "cia402 hand: all five drives follow their setpoints {:.0} ms after handsim started",
+        t.as_secs_f64() * 1e3
+    );
+    // The trip: the ring finger stopped with its EMCY named, the other four still following.
+    // A timeout is judged after the bus log is read (below), which says whose it was.
+    let trip_seen = poll_drives(
+        &env,
+        &cfg,
+        "the ring drive's trip is seen, the others follow",
+        Duration::from_secs(TRIP_S as u64 + 4),
+        true,
+        |d| {
+            d.len() == 5
+                && d.iter().enumerate().all(|(f, l)| {
+                    if f == TRIPPED {
+                        l.faulted && l.state.contains("EMCY") && l.state.contains("0x2310")
+                    } else {
+                        !l.faulted && l.state.starts_with(FOLLOWING)
+                    }
+                })
+        },
+    );
+    let tripped_at = now_us();
+    if trip_seen.is_ok() {
+        std::thread::sleep(Duration::from_millis(3_000));
+    }
+    let kill_at = now_us();
+    handd.kill();
+    std::thread::sleep(Duration::from_millis(600));
+    sim.kill();
+    let seen = monitor.finish();
+    let start = scenario_start_us(&seen);
+    let frames: Vec<(u64, u32, Vec<u8>)> = seen
+        .iter()
+        .filter_map(|s| s.frame.as_ref().map(|f| (s.time_us, f)))
+        .filter(|(_, f)| !f.is_extended())
+        .map(|(t, f)| (t, f.raw_id(), f.data().to_vec()))
+        .collect();
+    let of = |id: u32, from: u64, to: u64| -> Vec<&(u64, u32, Vec<u8>)> {
+        frames
+            .iter()
+            .filter(|f| f.1 == id && f.0 > from && f.0 < to)
+            .collect()
+    };
+    // While handd ran, no drive lost its heartbeat: handd's heartbeat (0x77F) on the bus, its
+    // largest gap, and each drive's heartbeat-loss EMCY before the kill, if any.
+    let beats: Vec<u64> = of(0x77F, start, kill_at).iter().map(|f| f.0).collect();
+    let (gap, gap_at) = beats
+        .windows(2)
+        .map(|w| (w[1] - w[0], w[0] - start))
+        .max()
+        .unwrap_or((0, 0));
+    let lost: Vec<(usize, u64)> = (0..5)
+        .filter_map(|f| {
+            frames
+                .iter()
+                .find(|e| e.1 == 0x080 + node(f) && e.0 < kill_at && e.2[..2] == [0x30, 0x81])
+                .map(|e| (f, e.0 - start))
+        })
+        .collect();
+    println!(
+        "cia402 hand: handd's heartbeat on the bus: {} in {:.1} s, largest gap {:.1} ms (from \
+         {:.3} s into the scenario; the drives followed from {:.3} s); drives that lost it \
+         while handd ran (finger, us into the scenario): {lost:?}",
+        beats.len(),
+        (kill_at - start) as f64 * 1e-6,
+        gap as f64 * 1e-3,
+        gap_at as f64 * 1e-6,
+        following_at.saturating_sub(start) as f64 * 1e-6
+    );
+    assert!(
+        lost.is_empty(),
+        "drives stopped on their heartbeat watchdog while handd ran (largest gap between \
+         handd's heartbeats on the bus {:.1} ms, the watchdog 150 ms): {lost:?}",
+        gap as f64 * 1e-3
+    );
+    if let Err(e) = trip_seen {
+        panic!("{e}");
+    }
+    // No native setpoint: every finger is a drive's.
+    assert!(
+        frames.iter().all(|f| !FingerSetpoint::IDS.contains(&f.1)),
+        "a FINGER_SETPOINT on a bus where every finger is on a drive"
+    );
+    // The closed loop through the index drive: its reported torque (TPDO1, 0x6077) as
+    // fingertip force over full scale, against the patient's sine.
+    let scaling = DriveFingerConfig::SIM_SCALING
+        .validate()
+        .expect("the simulated drives' scaling");
+    let full_scale = TrackingConfig::default().full_scale_force_n;
+    let (mut target, mut tracked) = (Vec::new(), Vec::new());
+    let scored_from = following_at + SETTLE_US;
+    for f in of(0x180 + node(TRACKED), scored_from, kill_at) {
+        let permille = i16::from_le_bytes([f.2[2], f.2[3]]);
+        target.push(Target::SINE_4S.at(f.0 - start));
+        tracked.push(scaling.force_n(permille) / full_scale);
+    }
+    let span_s = (kill_at - scored_from) as f64 * 1e-6;
+    assert!(
+        target.len() as f64 >= 18.0 * span_s,
+        "only {} index TPDO1 in {span_s:.1} s of tracking",
+        target.len()
+    );
+    let m = decoder::eval::tracking_metrics(&target, &tracked).expect("metrics");
+    println!(
+        "cia402 hand: closed loop through the index drive: {} TPDO1 in {span_s:.1} s, R² {:.3}, \
+         RMSE {:.3} (force / full scale)",
+        target.len(),
+        m.r2,
+        m.rmse
+    );
+    assert!(
+        m.r2 >= 0.8,
+        "tracking R² {:.3} < 0.8 through the drive (RMSE {:.3})",
+        m.r2,
+        m.rmse
+    );
+    // The trip: from the ring drive's EMCY on the bus to handd's first quick stop for it,
+    // within the 100 ms every drill gives a safe stop (one RPDO1 built before handd read the
+    // EMCY may go first); then quick stops only, while the other four drives get Enable
+    // operation and SYNC follows every tick.
+    let emcy = frames
+        .iter()
+        .find(|f| f.1 == 0x080 + node(TRIPPED) && f.2[..2] == [0x10, 0x23])
+        .expect("the ring drive's trip EMCY (0x2310) on the bus");
+    let ring = of(0x200 + node(TRIPPED), emcy.0, kill_at);
+    let first_stop = ring
+        .iter()
+        .position(|f| f.2 == QUICK_STOP)
+        .expect("a quick stop for the tripped drive");
+    let dt = ring[first_stop].0 - emcy.0;
+    println!(
+        "cia402 hand: the ring drive's first quick stop {:.1} ms after its EMCY ({first_stop} \
+         RPDO1 built before it was read went first), {} quick stops until the kill",
+        dt as f64 * 1e-3,
+        ring.len() - first_stop
+    );
+    assert!(first_stop <= 1, "Enable operation after the trip: {ring:?}");
+    assert!(
+        dt <= 100_000,
+        "the quick stop {dt} us after the trip's EMCY"
+    );
+    assert!(
+        ring[first_stop..].iter().all(|f| f.2 == QUICK_STOP),
+        "the tripped drive enabled again before `arm`: {ring:?}"
+    );
+    for f in (0..5).filter(|f| *f != TRIPPED) {
+        let rpdos = of(0x200 + node(f), tripped_at, kill_at);
+        assert!(
+            (50..=64).contains(&rpdos.len()),
+            "finger {f}: {} RPDO1 in the 3 s after the trip",
+            rpdos.len()
+        );
+        assert!(
+            rpdos.iter().all(|r| r.2[..2] == [0x0F, 0x00]),
+            "finger {f} did not go on in Enable operation after another's trip: {rpdos:?}"
+        );
+    }
+    let syncs = of(SYNC, tripped_at, kill_at).len();
+    assert!((50..=64).contains(&syncs), "{syncs} SYNC in those 3 s");
+    // Killed: every drive's own watchdog stops it, the tripped one's too.
+    for f in 0..5 {
+        let emcy = frames
+            .iter()
+            .find(|e| e.1 == 0x080 + node(f) && e.0 > kill_at && e.2[..2] == [0x30, 0x81])
+            .unwrap_or_else(|| {
+                panic!("finger {f}: no heartbeat-loss EMCY (0x8130) after the kill")
+            });
+        let dt = emcy.0 - kill_at;
+        println!(
+            "cia402 hand: finger {f}'s drive stopped on its watchdog {:.1} ms after SIGKILL",
+            dt as f64 * 1e-3
+        );
+        assert!(
+            dt <= WATCHDOG_BAR_US,
+            "finger {f}: EMCY {dt} us after the kill"
+        );
+    }
+}
