@@ -107,8 +107,8 @@ pub enum Listens {
 impl Listens {
     /// A simulated CiA 402 drive: every frame but the EMG samples (3000 a second, which no
     /// drive reads). Its ids follow its node id and its SYNC follows its 0x1005, so it takes
-    /// the rest. On `vcan0` five drives each copying every EMG frame too fell behind, and the
-    /// kernel dropped frames from their full receive queues, handd's heartbeat among them.
+    /// the rest. On `vcan0` five drives that each copied every EMG frame too kept handsim at
+    /// over a third of the VM's CPU.
     pub const DRIVE: Listens =
         Listens::Except(&[EmgSamplesG0::ID, EmgSamplesG1::ID, EmgSamplesG2::ID]);
 
