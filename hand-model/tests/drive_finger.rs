@@ -3,7 +3,7 @@
 //! a torque target flexes the finger and an opposite one extends it, a stop brakes it, and a
 //! drive fault (EMCY) or a power cycle reaches the master as a latched fault.
 
-use hand_canopen::master::{BankSettings, DriveBank, DriveFault, DriveStatus, Target};
+use hand_canopen::master::{BankSettings, DriveBank, DriveFault, DriveStatus, Target, TorqueLimit};
 use hand_canopen::scaling::ScalingSettings;
 use hand_canopen::{CobId, Mode, NodeId, PowerState};
 use hand_model::dbc::CanFrame;
@@ -143,11 +143,11 @@ fn the_drive_starts_and_its_torque_moves_the_finger_both_ways() {
         r.bank.status(0)
     );
     let start = r.angle();
-    r.run(600_000, Target::Run(400));
+    r.run(600_000, Target::torque(400));
     assert_eq!(r.power(), PowerState::OperationEnabled);
     let flexed = r.angle();
     assert!(flexed > start + 0.2, "flexion: {start} -> {flexed} rad");
-    r.run(600_000, Target::Run(-400));
+    r.run(600_000, Target::torque(-400));
     let extended = r.angle();
     assert!(
         extended < flexed - 0.2,
@@ -172,9 +172,9 @@ fn velocity_mode_moves_the_finger_at_the_target_speed() {
     let start = r.angle();
     // 0.5 rad/s at the joint = 0.5 * 64 * 60 / (2 pi) rpm at the motor.
     let rpm = (0.5 * 64.0 * 60.0 / std::f64::consts::TAU).round() as i32;
-    r.run(200_000, Target::Run(rpm));
+    r.run(200_000, Target::velocity(rpm, TorqueLimit(1000)));
     let a = r.angle();
-    r.run(400_000, Target::Run(rpm));
+    r.run(400_000, Target::velocity(rpm, TorqueLimit(1000)));
     let speed = (r.angle() - a) / 0.4;
     assert!(r.angle() > start);
     assert!((speed - 0.5).abs() < 0.05, "{speed} rad/s");
@@ -183,33 +183,33 @@ fn velocity_mode_moves_the_finger_at_the_target_speed() {
 #[test]
 fn a_tripped_or_power_cycled_drive_reaches_the_master_as_a_fault() {
     let mut r = Rig::new(Mode::CyclicSyncTorque);
-    r.run(500_000, Target::Run(300));
+    r.run(500_000, Target::torque(300));
     assert!(r.bank.is_enabled(0));
     r.world
         .drive_finger_mut(INDEX)
         .expect("drive")
         .inject_fault(0x2310);
-    r.run(100_000, Target::Run(300));
+    r.run(100_000, Target::torque(300));
     assert!(
         matches!(r.bank.status(0), DriveStatus::Faulted(DriveFault::Emcy(e)) if e.code == 0x2310),
         "{:?}",
         r.bank.status(0)
     );
     let held = r.angle();
-    r.run(300_000, Target::Run(300));
+    r.run(300_000, Target::torque(300));
     assert!(
         (r.angle() - held).abs() < 1e-3,
         "a faulted drive does not move"
     );
     r.bank.arm();
-    r.run(500_000, Target::Run(300));
+    r.run(500_000, Target::torque(300));
     assert!(r.bank.is_enabled(0), "{:?}", r.bank.status(0));
     let now = r.now;
     r.world
         .drive_finger_mut(INDEX)
         .expect("drive")
         .power_cycle(now);
-    r.run(100_000, Target::Run(300));
+    r.run(100_000, Target::torque(300));
     assert_eq!(r.bank.status(0), DriveStatus::Faulted(DriveFault::Rebooted));
 }
 
@@ -234,9 +234,9 @@ fn scheduled_drive_faults_trip_and_power_cycle_the_drive_when_they_start() {
     )
     .expect("valid");
     let mut r = Rig::with_faults(Mode::CyclicSyncTorque, plan);
-    r.run(650_000, Target::Run(300));
+    r.run(650_000, Target::torque(300));
     assert!(r.bank.is_enabled(0), "{:?}", r.bank.status(0));
-    r.run(200_000, Target::Run(300));
+    r.run(200_000, Target::torque(300));
     assert!(
         matches!(r.bank.status(0), DriveStatus::Faulted(DriveFault::Emcy(e)) if e.code == 0x2310),
         "{:?}",
@@ -248,8 +248,8 @@ fn scheduled_drive_faults_trip_and_power_cycle_the_drive_when_they_start() {
         "once, not again while the fault lasts"
     );
     r.bank.arm();
-    r.run(500_000, Target::Run(300));
+    r.run(500_000, Target::torque(300));
     assert!(r.bank.is_enabled(0), "{:?}", r.bank.status(0));
-    r.run(300_000, Target::Run(300));
+    r.run(300_000, Target::torque(300));
     assert_eq!(r.bank.status(0), DriveStatus::Faulted(DriveFault::Rebooted));
 }
