@@ -1,6 +1,7 @@
 //! A finger moved by its simulated CiA 402 drive (issue 26 item 6), driven by handd's CANopen
 //! master core (`hand_canopen::master::DriveBank`) over the in-memory bus: the drive starts,
-//! a torque target flexes the finger and an opposite one extends it, a stop brakes it, and a
+//! a torque target flexes the finger and an opposite one extends it, a stop brakes it, a
+//! velocity target moves it at that speed with no more force than its torque limit, and a
 //! drive fault (EMCY) or a power cycle reaches the master as a latched fault.
 
 use hand_canopen::master::{BankSettings, DriveBank, DriveFault, DriveStatus, Target, TorqueLimit};
@@ -126,6 +127,15 @@ impl Rig {
             .drive()
             .power_state()
     }
+
+    fn force(&self) -> f64 {
+        self.world
+            .drive_fingers()
+            .find(|n| n.finger() == INDEX)
+            .expect("the index finger's drive")
+            .physics()
+            .force_n
+    }
 }
 
 #[test]
@@ -178,6 +188,51 @@ fn velocity_mode_moves_the_finger_at_the_target_speed() {
     let speed = (r.angle() - a) / 0.4;
     assert!(r.angle() > start);
     assert!((speed - 0.5).abs() < 0.05, "{speed} rad/s");
+}
+
+/// CSV with the torque limit (0x6072) in RPDO1: the finger pushes into its stop with the
+/// limit's force in N at the fingertip (250 per mille of 40 N = 10 N), never its full 20 N; no
+/// limit, no motion; a limit above the finger's own maximum leaves that maximum.
+#[test]
+fn in_velocity_mode_the_torque_limit_bounds_the_fingers_force() {
+    let mut r = Rig::new(Mode::CyclicSyncVelocity);
+    r.run(300_000, Target::Stop);
+    let rpm = (1.0 * 64.0 * 60.0 / std::f64::consts::TAU).round() as i32;
+    let start = r.angle();
+    r.run(500_000, Target::velocity(rpm, TorqueLimit::ZERO));
+    assert!(r.bank.is_enabled(0), "{:?}", r.bank.status(0));
+    assert!(
+        (r.angle() - start).abs() < 1e-3,
+        "no torque, no motion: {start} -> {}",
+        r.angle()
+    );
+    assert_eq!(r.force(), 0.0);
+    // 1 rad/s flexes the finger into its stop at 1.6 rad within 2.5 s.
+    r.run(2_500_000, Target::velocity(rpm, TorqueLimit(250)));
+    assert!(r.angle() > 1.55, "at the stop: {}", r.angle());
+    for _ in 0..10 {
+        r.run(50_000, Target::velocity(rpm, TorqueLimit(250)));
+        assert!(
+            (r.force() - 10.0).abs() < 1e-9,
+            "pushing with the limit's 10 N: {} N",
+            r.force()
+        );
+    }
+    r.run(500_000, Target::velocity(rpm, TorqueLimit(1000)));
+    assert!(
+        (r.force() - 20.0).abs() < 1e-9,
+        "40 N asked, the finger's 20 N: {} N",
+        r.force()
+    );
+    let od = r
+        .world
+        .drive_fingers()
+        .next()
+        .expect("one drive")
+        .drive()
+        .od()
+        .get(hand_canopen::ObjectAddr::new(0x6072, 0));
+    assert_eq!(od, 1000, "0x6072 as RPDO1 carried it");
 }
 
 #[test]
