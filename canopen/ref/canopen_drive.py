@@ -294,6 +294,7 @@ class Drive:
             "rpdo_length_errors": self.rpdo_len_errors,
             "consumer_heartbeat": self.u(0x1016, 1),
             "mode": self.u(0x6060),
+            "max_torque": self.u(0x6072),
             "rpdo": maps(self.node.rpdo),
             "tpdo": maps(self.node.tpdo),
         }

@@ -220,15 +220,19 @@ impl PdoConfig {
     }
 }
 
-/// The PDOs of a finger drive in `mode`: RPDO1 controlword + target; TPDO1 statusword,
-/// torque actual, velocity actual; TPDO2 position actual; the rest disabled. Every
-/// PDO synchronous (type 1: RPDO applied and TPDO sent on each SYNC).
+/// The PDOs of a finger drive in `mode`: RPDO1 controlword + target (CST: target torque; CSV
+/// and PV: target velocity + max torque 0x6072, the velocity loop's torque limit); TPDO1
+/// statusword, torque actual, velocity actual; TPDO2 position actual; the rest disabled.
+/// Every PDO synchronous (type 1: RPDO applied and TPDO sent on each SYNC).
 pub fn finger_pdos(node: NodeId, mode: Mode) -> Vec<PdoConfig> {
-    let target = match mode {
-        Mode::CyclicSyncTorque => Mapped::new(objects::TARGET_TORQUE, 0, 16),
-        Mode::CyclicSyncVelocity | Mode::ProfileVelocity => {
-            Mapped::new(objects::TARGET_VELOCITY, 0, 32)
-        }
+    let controlword = Mapped::new(objects::CONTROLWORD, 0, 16);
+    let rpdo1 = match mode {
+        Mode::CyclicSyncTorque => vec![controlword, Mapped::new(objects::TARGET_TORQUE, 0, 16)],
+        Mode::CyclicSyncVelocity | Mode::ProfileVelocity => vec![
+            controlword,
+            Mapped::new(objects::TARGET_VELOCITY, 0, 32),
+            Mapped::new(objects::MAX_TORQUE, 0, 16),
+        ],
     };
     let mut out = Vec::with_capacity(8);
     for (direction, function) in [
@@ -237,7 +241,7 @@ pub fn finger_pdos(node: NodeId, mode: Mode) -> Vec<PdoConfig> {
     ] {
         for number in 1..=4u8 {
             let entries = match (direction, number) {
-                (Direction::Rx, 1) => vec![Mapped::new(objects::CONTROLWORD, 0, 16), target],
+                (Direction::Rx, 1) => rpdo1.clone(),
                 (Direction::Tx, 1) => vec![
                     Mapped::new(objects::STATUSWORD, 0, 16),
                     Mapped::new(objects::TORQUE_ACTUAL, 0, 16),

@@ -91,6 +91,17 @@ impl Scaling {
         }
     }
 
+    /// Max torque (0x6072) for a fingertip force limit: the force's magnitude in per mille,
+    /// saturated at the limit; NaN gives 0 (no torque).
+    pub fn max_torque_permille(&self, force_n: f64) -> u16 {
+        self.torque_permille(force_n).unsigned_abs()
+    }
+
+    /// Fingertip force for a max torque (0x6072) in per mille.
+    pub fn limit_force_n(&self, permille: u16) -> f64 {
+        f64::from(permille) / self.permille_per_n
+    }
+
     /// Fingertip force for a torque (0x6077) in per mille.
     pub fn force_n(&self, permille: i16) -> f64 {
         f64::from(permille) / self.permille_per_n

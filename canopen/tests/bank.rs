@@ -1,7 +1,9 @@
 //! The drive bank (every finger drive after start-up) against simulated CiA 402 drives on
 //! an in-memory bus: start-up, per-tick RPDO1 + SYNC + heartbeat, faults latched until `arm`.
 
-use hand_canopen::master::{BankError, BankSettings, DriveBank, DriveFault, DriveStatus, Target};
+use hand_canopen::master::{
+    BankError, BankSettings, DriveBank, DriveFault, DriveStatus, Target, TorqueLimit,
+};
 use hand_canopen::sim::SimDrive;
 use hand_canopen::startup::{Step, StepFailure};
 use hand_canopen::{CanFrame, CobId, Mode, NmtState, NodeId, ObjectAddr, PowerState};
@@ -129,7 +131,11 @@ impl Hand {
 }
 
 const STOP: [Target; 3] = [Target::Stop; 3];
-const RUN: [Target; 3] = [Target::Run(250), Target::Run(-1200), Target::Run(900)];
+const RUN: [Target; 3] = [
+    Target::torque(250),
+    Target::velocity(-1200, TorqueLimit(400)),
+    Target::velocity(900, TorqueLimit(650)),
+];
 
 /// Started and then driven: every drive enabled and following its target.
 fn running() -> Hand {
@@ -155,6 +161,11 @@ fn every_drive_starts_then_follows_its_target_each_tick() {
     assert_eq!(h.od(0, 0x6071, 0) as u16 as i16, 250);
     assert_eq!(h.od(1, 0x60FF, 0) as i32, -1200);
     assert_eq!(h.od(2, 0x60FF, 0) as i32, 900);
+    // The velocity drives' torque limit arrived with the target; the torque drive's 0x6072
+    // is not mapped and keeps its default.
+    assert_eq!(h.od(1, 0x6072, 0), 400);
+    assert_eq!(h.od(2, 0x6072, 0), 650);
+    assert_eq!(h.od(0, 0x6072, 0), 1000);
     let DriveStatus::Running {
         feedback: Some(fb), ..
     } = h.bank.status(0)
@@ -170,6 +181,11 @@ fn every_drive_starts_then_follows_its_target_each_tick() {
         vec![0x205, 0x206, 0x207, SYNC, 0x700 + u16::from(MASTER)]
     );
     assert_eq!(frames[0].payload(), &[0x0F, 0x00, 250, 0x00]);
+    let v = (-1200_i32).to_le_bytes();
+    assert_eq!(
+        frames[1].payload(),
+        &[0x0F, 0x00, v[0], v[1], v[2], v[3], 0x90, 0x01]
+    );
     assert_eq!(frames[4].payload(), &[NmtState::Operational.byte()]);
     for d in &h.drives {
         assert_eq!(d.power_state(), PowerState::OperationEnabled);
@@ -183,7 +199,10 @@ fn a_stop_is_a_quick_stop_with_the_target_zeroed_and_running_again_walks_the_sta
     let frames = h.tick(&STOP);
     for f in &frames[..3] {
         assert_eq!(&f.payload()[..2], &[0x02, 0x00], "quick stop controlword");
-        assert!(f.payload()[2..].iter().all(|&b| b == 0), "target zeroed");
+        assert!(
+            f.payload()[2..].iter().all(|&b| b == 0),
+            "target (and torque limit) zeroed"
+        );
     }
     h.ticks(2, &STOP);
     for (k, d) in h.drives.iter().enumerate() {
@@ -203,6 +222,11 @@ fn a_stop_is_a_quick_stop_with_the_target_zeroed_and_running_again_walks_the_sta
                 &frames[0].payload()[2..4],
                 &[0, 0],
                 "no target before enabled"
+            );
+            assert_eq!(
+                &frames[1].payload()[2..],
+                &[0; 6],
+                "no target and no torque limit before enabled"
             );
         }
     }

@@ -12,9 +12,11 @@ use std::io::{BufRead, BufReader, Write};
 use std::path::PathBuf;
 use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
 
-use hand_canopen::cia402::{Statusword, TRANSITIONS};
+use hand_canopen::cia402::{Controlword, Statusword, TRANSITIONS};
 use hand_canopen::emcy::{Emcy, ErrorClass, ERROR_CODES};
 use hand_canopen::heartbeat::HeartbeatProducer;
+use hand_canopen::master::cyclic::rpdo1;
+use hand_canopen::master::{Setpoint, TorqueLimit};
 use hand_canopen::pdo::{finger_pdos, Direction, PdoConfig};
 use hand_canopen::sdo::{SdoClient, SdoError, ABORT_CODES};
 use hand_canopen::sim::od::{Access, ObjectDictionary, FINGER_DRIVE_OBJECTS, SIM_VENDOR_ID};
@@ -238,8 +240,8 @@ fn assert_maps_agree(ours: &[PdoConfig], theirs: &Value, direction: Direction) {
     }
 }
 
-#[test]
-fn master_core_against_python_canopen() {
+/// The canopen script started, our tables checked against it (its first answer).
+fn spawn_with_tables_checked() -> PyDrive {
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/ref/canopen_drive.py");
     let mut child = Command::new(python())
         .arg(script)
@@ -256,7 +258,6 @@ fn master_core_against_python_canopen() {
         heard: Vec::new(),
     };
 
-    // 1. Tables.
     py.send_line(&init_json().to_string());
     let report: Value = serde_json::from_str(&py.line()).expect("report JSON");
     let mismatches = report["mismatches"].as_array().expect("mismatch list");
@@ -274,9 +275,11 @@ fn master_core_against_python_canopen() {
         let n = report["checked"][what].as_u64().unwrap_or(0);
         assert!(n as usize >= at_least, "only {n} {what} compared");
     }
+    py
+}
 
-    // 2. Start-up against the LocalNode drive.
-    let mode = Mode::CyclicSyncTorque;
+/// Our start-up in `mode` against the LocalNode drive, to Operation enabled.
+fn start_up(py: &mut PyDrive, mode: Mode) -> Master {
     let settings = StartupSettings {
         node: node(DRIVE),
         master: node(MASTER),
@@ -299,15 +302,49 @@ fn master_core_against_python_canopen() {
         sync: None,
     };
     while m.now < 2_000_000 && matches!(m.startup.status(), StartupStatus::Running(_)) {
-        m.step(&mut py);
+        m.step(py);
     }
     let StartupStatus::Done { identity, .. } = m.startup.status() else {
         panic!(
-            "start-up against canopen's LocalNode: {:?}",
+            "start-up in {mode:?} against canopen's LocalNode: {:?}",
             m.startup.status()
         );
     };
     assert_eq!(identity.vendor, SIM_VENDOR_ID);
+    m
+}
+
+/// Delivers `rpdo1`, then one SYNC: the drive's TPDO1 in answer, decoded by `tpdo1`.
+fn rpdo_then_sync(
+    m: &mut Master,
+    py: &mut PyDrive,
+    rpdo1: CanFrame,
+    tpdo1: &PdoConfig,
+) -> Vec<u32> {
+    m.deliver(py, vec![rpdo1]);
+    m.sync = Some(
+        SyncProducer::try_new(10_000)
+            .expect("period")
+            .on_cob_id(hand_canopen::CobId::try_new(SYNC_COB).expect("11 bits")),
+    );
+    let heard = py.heard.len();
+    m.step(py);
+    let tpdo = py.heard[heard..]
+        .iter()
+        .find(|(_, f)| f.cob_id() == tpdo1.cob_id.raw())
+        .map(|(_, f)| *f)
+        .expect("TPDO1 on SYNC from the canopen drive");
+    tpdo1.decode(&tpdo).expect("TPDO1 decodes")
+}
+
+#[test]
+fn master_core_against_python_canopen() {
+    // 1. Tables.
+    let mut py = spawn_with_tables_checked();
+
+    // 2. Start-up against the LocalNode drive.
+    let mode = Mode::CyclicSyncTorque;
+    let mut m = start_up(&mut py, mode);
 
     // 3. A setpoint RPDO and SYNC: the TPDO canopen's PdoMap encoded, decoded by us.
     let pdos = finger_pdos(node(DRIVE), mode);
@@ -318,20 +355,7 @@ fn master_core_against_python_canopen() {
         .expect("TPDO1");
     let target: i16 = 250;
     let f = rpdo.encode(&[0x000F, target as u16 as u32]).expect("RPDO1");
-    m.deliver(&mut py, vec![f]);
-    m.sync = Some(
-        SyncProducer::try_new(10_000)
-            .expect("period")
-            .on_cob_id(hand_canopen::CobId::try_new(SYNC_COB).expect("11 bits")),
-    );
-    let heard = py.heard.len();
-    m.step(&mut py);
-    let tpdo = py.heard[heard..]
-        .iter()
-        .find(|(_, f)| f.cob_id() == tpdo1.cob_id.raw())
-        .map(|(_, f)| *f)
-        .expect("TPDO1 on SYNC from the canopen drive");
-    let v = tpdo1.decode(&tpdo).expect("TPDO1 decodes");
+    let v = rpdo_then_sync(&mut m, &mut py, f, tpdo1);
     assert_eq!(
         Statusword(v[0] as u16).state(),
         Some(PowerState::OperationEnabled)
@@ -408,6 +432,46 @@ fn master_core_against_python_canopen() {
         json!((u32::from(MASTER) << 16) | 100)
     );
     // The PDO configuration our plan wrote, as canopen reads it back from its dictionary.
+    assert_maps_agree(&pdos, &summary["rpdo"], Direction::Rx);
+    assert_maps_agree(&pdos, &summary["tpdo"], Direction::Tx);
+    let status = py.child.wait().expect("the canopen script exits");
+    assert!(status.success(), "the canopen script failed: {status}");
+}
+
+/// CSV: RPDO1 = controlword + target velocity + max torque (0x6072), as handd's fixed layout
+/// encodes it, mapped by our start-up into canopen's dictionary (0x6072 PDO-mappable in the
+/// EDS) and applied there on SYNC; the mapping read back agrees.
+#[test]
+fn csv_rpdo1_with_the_torque_limit_against_python_canopen() {
+    let mut py = spawn_with_tables_checked();
+    let mode = Mode::CyclicSyncVelocity;
+    let mut m = start_up(&mut py, mode);
+    let pdos = finger_pdos(node(DRIVE), mode);
+    let tpdo1 = pdos
+        .iter()
+        .find(|p| p.direction == Direction::Tx && p.number == 1)
+        .expect("TPDO1");
+    let f = rpdo1(
+        node(DRIVE),
+        mode,
+        Controlword(0x000F),
+        Setpoint {
+            value: -2_500,
+            max_torque: TorqueLimit(375),
+        },
+    );
+    assert_eq!(f.payload().len(), 8);
+    let v = rpdo_then_sync(&mut m, &mut py, f, tpdo1);
+    assert_eq!(
+        Statusword(v[0] as u16).state(),
+        Some(PowerState::OperationEnabled)
+    );
+    assert_eq!(v[2] as i32, -2_500, "velocity actual follows the target");
+    py.send_line("Q");
+    let summary: Value = serde_json::from_str(&py.line()).expect("summary JSON");
+    assert_eq!(summary["mode"], json!(mode.value()));
+    assert_eq!(summary["max_torque"], json!(375), "0x6072 as RPDO1 set it");
+    assert_eq!(summary["rpdo_length_errors"], json!(0));
     assert_maps_agree(&pdos, &summary["rpdo"], Direction::Rx);
     assert_maps_agree(&pdos, &summary["tpdo"], Direction::Tx);
     let status = py.child.wait().expect("the canopen script exits");

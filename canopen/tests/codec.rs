@@ -407,6 +407,16 @@ fn scaling_follows_the_arm_and_gear() {
     assert_eq!(s.torque_permille(1e9), 1_000);
     assert_eq!(s.velocity_rpm(-1e9), -10_000);
     assert_eq!(s.torque_permille(f64::NAN), 0);
+    // The torque limit (0x6072) is the force's magnitude, saturated, NaN none.
+    assert_eq!(s.max_torque_permille(10.0), 100);
+    assert_eq!(s.max_torque_permille(-10.0), 100);
+    assert_eq!(s.max_torque_permille(0.0), 0);
+    assert_eq!(s.max_torque_permille(1e9), 1_000);
+    assert_eq!(s.max_torque_permille(-1e9), 1_000);
+    assert_eq!(s.max_torque_permille(f64::INFINITY), 1_000);
+    assert_eq!(s.max_torque_permille(f64::NAN), 0);
+    assert!((s.limit_force_n(100) - 10.0).abs() < 1e-9);
+    assert!((s.limit_force_n(u16::MAX) - 6553.5).abs() < 1e-9);
     let bad = ScalingSettings {
         gear_ratio: 0.0,
         rated_torque_mnm: 1.0,

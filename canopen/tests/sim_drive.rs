@@ -374,3 +374,46 @@ fn a_drive_that_keeps_booting_during_its_start_up_fails_it() {
     assert_eq!(e.cause, StepFailure::UnexpectedBootUp);
     assert!(e.to_string().contains("kept booting"), "{e}");
 }
+
+/// CSV: the 8-byte RPDO1 (controlword, target velocity, max torque) is applied on SYNC with
+/// 0x6072 set; one in the old 6-byte layout, without the limit, is refused and counted
+/// (EMCY 0x8210) and leaves the limit as it was.
+#[test]
+fn csv_rpdo1_carries_the_torque_limit_and_the_old_layout_is_a_length_error() {
+    let mut b = started(Mode::CyclicSyncVelocity);
+    b.sync = Some(
+        SyncProducer::try_new(10_000)
+            .expect("period > 0")
+            .on_cob_id(sync_cob()),
+    );
+    let f = hand_canopen::master::cyclic::rpdo1(
+        node(DRIVE),
+        Mode::CyclicSyncVelocity,
+        hand_canopen::cia402::Controlword(0x000F),
+        hand_canopen::master::Setpoint {
+            value: 1_500,
+            max_torque: hand_canopen::master::TorqueLimit(320),
+        },
+    );
+    b.send(f);
+    b.step(10_000);
+    let od = b.drive.od();
+    assert_eq!(od.get_i32(ObjectAddr::new(0x60FF, 0)), 1_500);
+    assert_eq!(od.get(ObjectAddr::new(0x6072, 0)), 320);
+    assert_eq!(b.drive.stats().rpdo_length_errors, 0);
+    let first = b.from_drive.len();
+    let v = (-900_i32).to_le_bytes();
+    let old = hand_canopen::CanFrame::new(f.cob_id(), &[0x0F, 0x00, v[0], v[1], v[2], v[3]])
+        .expect("frame");
+    b.send(old);
+    b.step(10_000);
+    let emcy = b.from_drive[first..]
+        .iter()
+        .find_map(|(_, f)| Emcy::decode(f).ok())
+        .expect("EMCY for the 6-byte RPDO1");
+    assert_eq!(emcy.code, EMCY_PDO_LENGTH);
+    assert_eq!(b.drive.stats().rpdo_length_errors, 1);
+    let od = b.drive.od();
+    assert_eq!(od.get_i32(ObjectAddr::new(0x60FF, 0)), 1_500);
+    assert_eq!(od.get(ObjectAddr::new(0x6072, 0)), 320);
+}

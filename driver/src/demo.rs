@@ -11,9 +11,9 @@
 //! tracking runs on the system clock in real time, or on a virtual clock with `fast`.
 //!
 //! With [`DriveProfile::Cia402`] every finger of the tracking phase is moved by a simulated
-//! CiA 402 drive (`hand_model::nodes::DriveFingerNode`, node 5 + finger, cyclic synchronous
-//! torque) that handd starts over the bus and drives as a handd.toml with
-//! `[fingers.NAME.drive] profile = "cia402"` asks; the patient then feels the index finger's
+//! CiA 402 drive (`hand_model::nodes::DriveFingerNode`, node 5 + finger, in the profile's mode:
+//! cyclic synchronous torque, or velocity with the force as its torque limit) that handd starts
+//! over the bus and drives as a handd.toml with `[fingers.NAME.drive] profile = "cia402"` asks; the patient then feels the index finger's
 //! force from the finger itself (a drive sends no FINGER_STATUS), and the score reads it there.
 
 use std::path::{Path, PathBuf};
@@ -78,23 +78,24 @@ pub enum DriveProfile {
     /// hand.dbc's native finger controllers (FINGER_SETPOINT, FINGER_STATUS).
     #[default]
     Native,
-    /// A simulated CiA 402 drive per finger, started and driven by handd over CANopen.
-    Cia402,
+    /// A simulated CiA 402 drive per finger, started and driven by handd over CANopen in this
+    /// mode.
+    Cia402(DriveMode),
 }
 
 impl DriveProfile {
     /// The daemon's configuration for this profile: the defaults, and for CiA 402 each
     /// finger's `[fingers.NAME.drive]` table as a technician would write it for the simulated
-    /// drives (node 5 + finger, cyclic synchronous torque, their scaling).
+    /// drives (node 5 + finger, the profile's mode, their scaling).
     pub fn config(self) -> Config {
         let mut config = Config::default();
-        if self == Self::Cia402 {
+        if let Self::Cia402(mode) = self {
             let s = DriveFingerConfig::SIM_SCALING;
             for f in 0..N_FINGERS {
                 config.fingers.get_mut(f).drive = DriveConfig {
                     profile: Profile::Cia402,
                     node_id: Some(simulated_node_id(f)),
-                    mode: Some(DriveMode::Cst),
+                    mode: Some(mode),
                     rated_torque_mnm: Some(s.rated_torque_mnm),
                     gear_ratio: Some(s.gear_ratio),
                     moment_arm_m: Some(s.moment_arm_m),
@@ -109,7 +110,7 @@ impl DriveProfile {
     /// The simulated world's drives for this profile.
     fn world_drives(self) -> Result<[Option<DriveFingerConfig>; N_FINGERS], DemoError> {
         let mut out = [None; N_FINGERS];
-        if self == Self::Cia402 {
+        if matches!(self, Self::Cia402(_)) {
             for (f, slot) in out.iter_mut().enumerate() {
                 *slot = Some(DriveFingerConfig::simulated(f)?);
             }
@@ -182,7 +183,7 @@ pub struct TrackingReport {
     pub mean_abs_label: [f64; N_FINGERS],
     /// Per finger, the mean |velocity setpoint| handd sent over the scored time, rad/s: what
     /// the output law makes of the labels (the fingers the patient does not move should stay
-    /// near 0). For a finger on a CiA 402 drive (torque mode), the joint's mean |velocity|.
+    /// near 0). For a finger on a CiA 402 drive (in any mode), the joint's mean |velocity|.
     pub mean_abs_velocity: [f64; N_FINGERS],
     /// Per finger, the time its controller reported being at a joint stop with the command
     /// pushing into it (FINGER_STATUS fault bit 5) over the scored time, s.
@@ -381,9 +382,14 @@ pub fn track_model(
         DriveProfile::Native => {
             "tracking: the daemon drives the hand, the patient follows a sine with the index finger"
         }
-        DriveProfile::Cia402 => {
+        DriveProfile::Cia402(DriveMode::Cst) => {
             "tracking: the daemon starts a CiA 402 drive per finger and drives the hand through \
-             them, the patient follows a sine with the index finger"
+             them in torque mode (cst), the patient follows a sine with the index finger"
+        }
+        DriveProfile::Cia402(DriveMode::Csv | DriveMode::Pv) => {
+            "tracking: the daemon starts a CiA 402 drive per finger and drives the hand through \
+             them in velocity mode with the force as torque limit, the patient follows a sine \
+             with the index finger"
         }
     }));
     let (

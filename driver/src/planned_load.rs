@@ -2,7 +2,8 @@
 //! it): hand.dbc's messages at their DBC rates ([`hand_dbc::busload`]), each finger's
 //! FINGER_SETPOINT once per tick, and for a finger on a CiA 402 drive its drive's traffic in place
 //! of its FINGER_SETPOINT and FINGER_STATUS:
-//! - per tick, its RPDO1 (controlword and target: 4 bytes in torque mode, 6 in velocity modes);
+//! - per tick, its RPDO1 (controlword and target: 4 bytes in torque mode; controlword, target
+//!   and max torque: 8 bytes in velocity modes);
 //! - on each SYNC (one per tick), its TPDO1 (statusword, torque, velocity: 8 bytes) and TPDO2
 //!   (position: 4 bytes), as [`hand_canopen::pdo::finger_pdos`] maps them;
 //! - its heartbeat, once per tick (0x1017 is the tick: [`crate::engine::bank_settings`]);
@@ -257,12 +258,25 @@ mod tests {
     #[test]
     fn velocity_drives_send_a_longer_rpdo_and_a_10_ms_tick_goes_over_the_limit() {
         let torque = planned_load(&five_drives(Mode::CyclicSyncTorque), 50_000);
-        let velocity = planned_load(&five_drives(Mode::CyclicSyncVelocity), 50_000);
-        // RPDO1 of 6 bytes: 47 + 48 + floor(81 / 4) = 115 bits, 20 more per drive and tick.
-        let more = velocity.bits_per_s() - torque.bits_per_s();
-        assert!((more - 5.0 * 20.0 * 20.0).abs() < 1e-6, "{more}");
+        for mode in [Mode::CyclicSyncVelocity, Mode::ProfileVelocity] {
+            let velocity = planned_load(&five_drives(mode), 50_000);
+            // RPDO1 of 8 bytes (the torque limit too): 47 + 64 + floor(97 / 4) = 135 bits, 40
+            // more than the torque mode's 95 per drive and tick.
+            let more = velocity.bits_per_s() - torque.bits_per_s();
+            assert!((more - 5.0 * 40.0 * 20.0).abs() < 1e-6, "{mode:?}: {more}");
+            assert!(velocity.within_limit(), "{velocity}");
+        }
+        // The README's table: five csv drives at a 50 ms and a 10 ms tick (= SYNC).
+        let csv = planned_load(&five_drives(Mode::CyclicSyncVelocity), 50_000);
+        assert!((csv.bits_per_s() - 465_550.0).abs() < 1e-6, "{csv}");
+        let csv_fast = planned_load(&five_drives(Mode::CyclicSyncVelocity), 10_000);
+        assert!(!csv_fast.within_limit(), "{csv_fast}");
         let fast = planned_load(&five_drives(Mode::CyclicSyncTorque), 10_000);
         assert!(!fast.within_limit(), "{fast}");
         assert!(fast.to_string().contains("OVER"), "{fast}");
+        assert!(
+            (csv_fast.bits_per_s() - fast.bits_per_s() - 5.0 * 40.0 * 100.0).abs() < 1e-6,
+            "{csv_fast}"
+        );
     }
 }

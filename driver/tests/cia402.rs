@@ -29,6 +29,11 @@ fn node() -> NodeId {
 }
 
 fn settings() -> EngineSettings {
+    settings_in(Mode::CyclicSyncTorque)
+}
+
+/// The index finger on the drive in `mode`.
+fn settings_in(mode: Mode) -> EngineSettings {
     let scaling = ScalingSettings {
         rated_torque_mnm: 25.0,
         gear_ratio: 64.0,
@@ -41,7 +46,7 @@ fn settings() -> EngineSettings {
     let mut fingers = [Drive::Native; 5];
     fingers[INDEX] = Drive::Cia402 {
         node: node(),
-        mode: Mode::CyclicSyncTorque,
+        mode,
         scaling,
     };
     EngineSettings {
@@ -64,14 +69,14 @@ struct Hand {
 }
 
 impl Hand {
-    fn new() -> Self {
+    fn in_mode(mode: Mode) -> Self {
         let rig = Rig::with_settings(
             FaultPlan::new(),
             PatientMode::Script(Script::resting(30_000_000)),
             random_predictor(7),
             |t| t,
             |b| b,
-            settings(),
+            settings_in(mode),
         );
         let mut port = rig.bus.endpoint();
         let mut drive = SimDrive::new(node());
@@ -137,7 +142,11 @@ fn send(port: &mut MemEndpoint, f: hand_canopen::CanFrame) {
 }
 
 fn running() -> Hand {
-    let mut h = Hand::new();
+    running_in(Mode::CyclicSyncTorque)
+}
+
+fn running_in(mode: Mode) -> Hand {
+    let mut h = Hand::in_mode(mode);
     h.run_until(3_000_000);
     let e = h.rig.runner.engine();
     assert_eq!(e.state(), DaemonState::Running, "{}", e.faults());
@@ -201,6 +210,69 @@ fn the_index_finger_runs_through_its_drive_rpdo_then_sync_each_tick() {
     };
     assert_eq!(target, scaling.torque_permille(force), "force {force} N");
     assert_eq!(h.drive.stats().watchdog_trips, 0);
+}
+
+/// CSV: each RPDO1 is 8 bytes, the velocity setpoint in rpm and the force setpoint's magnitude
+/// as the torque limit (0x6072), through the finger's scaling; the drive takes every one.
+#[test]
+fn in_csv_the_index_finger_sends_its_velocity_with_the_force_as_torque_limit() {
+    let mut h = running_in(Mode::CyclicSyncVelocity);
+    let from = h.rig.clock_now();
+    h.run_until(from + 500_000);
+    let sent = h.sent(from, from + 500_000);
+    let rpdo = 0x200 + u32::from(NODE);
+    let rpdos: Vec<_> = sent.iter().filter(|s| s.1 == rpdo).collect();
+    assert!(
+        (9..=11).contains(&rpdos.len()),
+        "{} RPDO1 in 0.5 s",
+        rpdos.len()
+    );
+    assert!(
+        rpdos
+            .iter()
+            .all(|s| s.2.len() == 8 && s.2[..2] == [0x0F, 0x00]),
+        "8 bytes, enable operation: {rpdos:?}"
+    );
+    let Drive::Cia402 { scaling, .. } = settings_in(Mode::CyclicSyncVelocity).drives.fingers[INDEX]
+    else {
+        unreachable!()
+    };
+    // The next tick's setpoint, taken right after it, against its RPDO1 (read a few ms later:
+    // the bus delivers a frame after its transmission time).
+    let deadline = h.rig.runner.next_deadline_us();
+    while h.rig.runner.next_deadline_us() == deadline {
+        let now = h.rig.clock_now();
+        h.run_until(now + 1_000);
+    }
+    let sp = h.rig.runner.engine().setpoints()[INDEX];
+    let ticked = h.rig.clock_now();
+    h.run_until(ticked + 5_000);
+    let after = h.sent(ticked - 1_000, ticked + 5_000);
+    let last = &after
+        .iter()
+        .find(|s| s.1 == rpdo)
+        .expect("the tick's RPDO1")
+        .2;
+    let rpm = i32::from_le_bytes([last[2], last[3], last[4], last[5]]);
+    let limit = u16::from_le_bytes([last[6], last[7]]);
+    assert_eq!(rpm, scaling.velocity_rpm(sp.velocity.0), "{sp:?}");
+    assert_eq!(limit, scaling.max_torque_permille(sp.force.0), "{sp:?}");
+    let limits: Vec<u16> = rpdos
+        .iter()
+        .map(|s| u16::from_le_bytes([s.2[6], s.2[7]]))
+        .collect();
+    assert!(
+        limits.iter().any(|&l| l > 0),
+        "the random predictor's forces give limits: {limits:?}"
+    );
+    // The drive applied them (the newest, or the one before if the last SYNC is unserved).
+    let applied = h.drive.od().get(ObjectAddr::new(0x6072, 0)) as u16;
+    assert!(
+        limits[limits.len() - 2..].contains(&applied),
+        "{applied} of {limits:?}"
+    );
+    assert_eq!(h.drive.stats().rpdo_length_errors, 0);
+    assert_eq!(h.drive.stats().emcys, 0);
 }
 
 #[test]

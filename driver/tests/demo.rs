@@ -2,6 +2,7 @@
 //! real daemon loop, and the simulated patient tracking a sine with the index finger.
 
 use driver::demo::{run_demo, track_model, DemoEvent, DemoOptions, DriveProfile};
+use driver::drive_config::DriveMode;
 
 #[test]
 fn demo_calibrates_trains_and_tracks_a_sine() {
@@ -63,7 +64,7 @@ fn demo_calibrates_trains_and_tracks_a_sine() {
     // Issue 26 item 6: the same model, every finger on a simulated CiA 402 drive that the
     // daemon starts over the bus and drives in torque mode: it tracks as natively (R² >= 0.8).
     let cia402 = DemoOptions {
-        drives: DriveProfile::Cia402,
+        drives: DriveProfile::Cia402(DriveMode::Cst),
         ..opts.clone()
     };
     let d = track_model(&saved, &cia402, |_| {}).unwrap();
@@ -105,6 +106,27 @@ fn demo_calibrates_trains_and_tracks_a_sine() {
         );
     }
     assert_eq!(d.end.counters.deadline_misses, 0);
+
+    // The same drives in csv with the force as torque limit (0x6072): the joint's speed is
+    // the velocity setpoint again, so the index hits its stops no faster than natively (the
+    // README's table: 1.71 rad/s native, 6.00 in cst, 1.73 in csv).
+    let csv = DemoOptions {
+        drives: DriveProfile::Cia402(DriveMode::Csv),
+        ..opts.clone()
+    };
+    let v = track_model(&saved, &csv, |_| {}).unwrap();
+    println!(
+        "csv:     R² {:.3} RMSE {:.3}, index at a stop {:.1} s, impacts {:?}; native impacts {:?}",
+        v.r2, v.rmse, v.at_stop_s[1], v.impacts[1], r.impacts[1]
+    );
+    assert_eq!(v.drives.enabled_at_end, 5, "{:?}", v.drives);
+    assert!(
+        v.impacts[1].1 <= 1.8,
+        "csv bounds the index's impacts as natively: {:?} (native {:?})",
+        v.impacts[1],
+        r.impacts[1]
+    );
+    assert_eq!(v.end.counters.deadline_misses, 0);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

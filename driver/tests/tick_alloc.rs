@@ -101,19 +101,20 @@ fn main() {
     );
     assert_eq!(stats.allocations, 0, "heap allocations in the tick");
     assert_eq!(stats.reallocations, 0, "heap reallocations in the tick");
-    with_a_cia402_drive(&frames);
-    println!("tick_alloc: 2 passed, 0 failed");
+    with_a_cia402_drive(&frames, hand_canopen::Mode::CyclicSyncTorque);
+    with_a_cia402_drive(&frames, hand_canopen::Mode::CyclicSyncVelocity);
+    println!("tick_alloc: 3 passed, 0 failed");
 }
 
-/// The same traffic with the index finger on a live simulated CiA 402 drive (node 6, CST):
-/// its RPDO1, SYNC and heartbeat every tick, its TPDO1, heartbeat and SDO answers into
+/// The same traffic with the index finger on a live simulated CiA 402 drive (node 6, in `mode`:
+/// CST, or CSV with the torque limit in RPDO1): its RPDO1, SYNC and heartbeat every tick, its TPDO1, heartbeat and SDO answers into
 /// `Engine::on_frame`. Only the engine's calls are counted (the simulated drive allocates
 /// between them, outside the product), from the first tick after the drive follows its
 /// target: its start-up (a boxed plan per drive, at construction and at `arm`) is not the tick.
-fn with_a_cia402_drive(frames: &[(u64, CanFrame)]) {
+fn with_a_cia402_drive(frames: &[(u64, CanFrame)], mode: hand_canopen::Mode) {
     use driver::drive_config::{Drive, Drives};
     use hand_canopen::sim::SimDrive;
-    use hand_canopen::{CobId, Mode, NodeId};
+    use hand_canopen::{CobId, NodeId};
     let node = NodeId::try_new(6).expect("in range");
     let scaling = hand_canopen::scaling::ScalingSettings {
         rated_torque_mnm: 25.0,
@@ -127,7 +128,7 @@ fn with_a_cia402_drive(frames: &[(u64, CanFrame)]) {
     let mut fingers = [Drive::Native; 5];
     fingers[1] = Drive::Cia402 {
         node,
-        mode: Mode::CyclicSyncTorque,
+        mode,
         scaling,
     };
     let settings = EngineSettings {
@@ -223,7 +224,7 @@ fn with_a_cia402_drive(frames: &[(u64, CanFrame)]) {
         to_engine.extend(from_drive.into_iter().map(|f| (now + 500, dbc(f))));
     }
     println!(
-        "with a CiA 402 drive: state {}, drive {:?}; {calls} engine calls counted: {} \
+        "with a CiA 402 drive in {mode:?}: state {}, drive {:?}; {calls} engine calls counted: {} \
          allocations or reallocations in on_frame, {} in the tick",
         engine.state(),
         engine
@@ -243,5 +244,10 @@ fn with_a_cia402_drive(frames: &[(u64, CanFrame)]) {
         "RPDO1 applied by the drive: {}",
         drive.stats().rpdos_applied
     );
-    assert_eq!(counted, (0, 0), "heap allocations with a CiA 402 drive");
+    assert_eq!(drive.stats().rpdo_length_errors, 0, "{mode:?}");
+    assert_eq!(
+        counted,
+        (0, 0),
+        "heap allocations with a CiA 402 drive in {mode:?}"
+    );
 }

@@ -253,10 +253,26 @@ pub struct DemoArgs {
     #[arg(long, value_enum, default_value_t = DemoLaw::Shipped)]
     pub law: DemoLaw,
     /// What moves the fingers while tracking: `native` (hand.dbc's finger controllers) or
-    /// `cia402` (a simulated CiA 402 drive per finger, node 5 + finger, torque mode, started
-    /// and driven by the daemon over CANopen).
+    /// `cia402` (a simulated CiA 402 drive per finger, node 5 + finger, in `--drive-mode`,
+    /// started and driven by the daemon over CANopen).
     #[arg(long, value_enum, default_value_t = DemoDrives::Native)]
     pub drives: DemoDrives,
+    /// With `--drives cia402`, the drives' mode: `cst` (cyclic synchronous torque: the force
+    /// setpoint, the default), `csv` (cyclic synchronous velocity: the velocity setpoint with
+    /// the force as torque limit, 0x6072) or `pv` (profile velocity, as csv).
+    #[arg(long, value_enum)]
+    pub drive_mode: Option<DemoDriveMode>,
+}
+
+/// `handctl demo --drive-mode`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum DemoDriveMode {
+    /// Cyclic synchronous torque.
+    Cst,
+    /// Cyclic synchronous velocity with the torque limit.
+    Csv,
+    /// Profile velocity with the torque limit.
+    Pv,
 }
 
 /// `handctl demo --drives`.

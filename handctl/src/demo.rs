@@ -5,14 +5,32 @@
 use std::io::{IsTerminal, Write};
 
 use driver::demo::{run_demo, DemoEvent, DemoOptions, DriveProfile, DrivesRecord, OutputLaw};
+use driver::drive_config::DriveMode;
 use driver::units::FINGER_NAMES;
 
-use super::args::{DemoArgs, DemoDrives, DemoLaw};
+use super::args::{DemoArgs, DemoDriveMode, DemoDrives, DemoLaw};
 use super::error::CliError;
 use super::progress::Progress;
 
+/// The fingers' drives `--drives` and `--drive-mode` ask for; a mode without drives is refused.
+fn drive_profile(a: &DemoArgs) -> Result<DriveProfile, CliError> {
+    let mode = a.drive_mode.map(|m| match m {
+        DemoDriveMode::Cst => DriveMode::Cst,
+        DemoDriveMode::Csv => DriveMode::Csv,
+        DemoDriveMode::Pv => DriveMode::Pv,
+    });
+    match (a.drives, mode) {
+        (DemoDrives::Native, None) => Ok(DriveProfile::Native),
+        (DemoDrives::Native, Some(_)) => Err(CliError::Usage(
+            "demo: --drive-mode needs --drives cia402 (native fingers have no drive mode)".into(),
+        )),
+        (DemoDrives::Cia402, mode) => Ok(DriveProfile::Cia402(mode.unwrap_or(DriveMode::Cst))),
+    }
+}
+
 /// `handctl demo`.
 pub fn run(a: &DemoArgs) -> Result<(), CliError> {
+    let drives = drive_profile(a)?;
     let opts = DemoOptions {
         seed: a.seed,
         fast: a.fast,
@@ -28,10 +46,7 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
             DemoLaw::Shipped => OutputLaw::Shipped,
             DemoLaw::Paper => OutputLaw::Paper,
         },
-        drives: match a.drives {
-            DemoDrives::Native => DriveProfile::Native,
-            DemoDrives::Cia402 => DriveProfile::Cia402,
-        },
+        drives,
         ..DemoOptions::default()
     };
     let tty = std::io::stdout().is_terminal();
@@ -105,10 +120,10 @@ pub fn run(a: &DemoArgs) -> Result<(), CliError> {
             &report.tracking.mean_abs_velocity,
             &report.tracking.at_stop_s,
             &report.tracking.impacts,
-            match a.drives {
-                DemoDrives::Native => "velocity setpoint",
-                // A torque-mode drive gets a torque: the joint's own velocity instead.
-                DemoDrives::Cia402 => "joint velocity",
+            match drives {
+                DriveProfile::Native => "velocity setpoint",
+                // A drive's finger sends no FINGER_SETPOINT to read: the joint's own velocity.
+                DriveProfile::Cia402(_) => "joint velocity",
             }
         )
     );
@@ -174,4 +189,60 @@ fn motion(
         "per finger: mean |{velocity}|, time at a joint stop, impacts into a stop: {}",
         fingers.join(", ")
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::args::{Cli, Command};
+    use clap::Parser;
+
+    fn profile(argv: &[&str]) -> Result<DriveProfile, CliError> {
+        let cli = Cli::try_parse_from(argv).expect("parses");
+        let Command::Demo(a) = &cli.command else {
+            panic!("not the demo: {:?}", cli.command);
+        };
+        drive_profile(a)
+    }
+
+    #[test]
+    fn the_drive_mode_defaults_to_cst_and_needs_drives() {
+        assert_eq!(
+            profile(&["handctl", "demo"]).expect("native"),
+            DriveProfile::Native
+        );
+        assert_eq!(
+            profile(&["handctl", "demo", "--drives", "cia402"]).expect("cst"),
+            DriveProfile::Cia402(DriveMode::Cst)
+        );
+        assert_eq!(
+            profile(&[
+                "handctl",
+                "demo",
+                "--drives",
+                "cia402",
+                "--drive-mode",
+                "csv"
+            ])
+            .expect("csv"),
+            DriveProfile::Cia402(DriveMode::Csv)
+        );
+        assert_eq!(
+            profile(&[
+                "handctl",
+                "demo",
+                "--drives",
+                "cia402",
+                "--drive-mode",
+                "pv"
+            ])
+            .expect("pv"),
+            DriveProfile::Cia402(DriveMode::Pv)
+        );
+        assert!(matches!(
+            profile(&["handctl", "demo", "--drive-mode", "csv"]),
+            Err(CliError::Usage(m)) if m.contains("--drives cia402")
+        ));
+        assert!(Cli::try_parse_from(["handctl", "demo", "--drive-mode", "cyclic"]).is_err());
+    }
 }

@@ -32,6 +32,8 @@ pub mod objects {
     pub const VELOCITY_ACTUAL: Index = 0x606C;
     /// Target torque (INTEGER16, per mille of rated torque).
     pub const TARGET_TORQUE: Index = 0x6071;
+    /// Max torque (UNSIGNED16, per mille of rated torque).
+    pub const MAX_TORQUE: Index = 0x6072;
     /// Rated torque (UNSIGNED32, mNm).
     pub const RATED_TORQUE: Index = 0x6076;
     /// Torque actual value (INTEGER16, per mille of rated torque).

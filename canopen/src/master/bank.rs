@@ -2,7 +2,7 @@
 //! the frames a tick sends (RPDO1 per drive, then one SYNC and handd's heartbeat, all from
 //! the caller's loop), and every frame from the bus routed to its drive.
 
-use super::cyclic::{decode_tpdo1, is_tpdo1_of, rpdo1, Feedback, Target};
+use super::cyclic::{decode_tpdo1, is_tpdo1_of, rpdo1, Feedback, Setpoint, Target};
 use super::fault::DriveFault;
 use crate::cia402::{Command, Controlword, DriverStep, Mode, PowerDriver, PowerState};
 use crate::emcy::Emcy;
@@ -359,11 +359,11 @@ impl DriveBank {
                 Phase::Running(r) => run_step(r, target, now_us, step_timeout_us),
                 _ => Ok(stop()),
             };
-            let (cw, value) = step.unwrap_or_else(|fault| {
+            let (cw, sp) = step.unwrap_or_else(|fault| {
                 s.fault(fault);
                 stop()
             });
-            out(rpdo1(node, mode, cw, value));
+            out(rpdo1(node, mode, cw, sp));
         }
         out(sync_frame_on(self.settings.sync_cob_id));
         out(self.heartbeat.frame(NmtState::Operational));
@@ -372,7 +372,8 @@ impl DriveBank {
 
 impl DriveBank {
     /// At once, outside the tick (the bus came back, handd exits): every configured drive's
-    /// RPDO1 with the quick stop and its target zeroed, then the SYNC that applies them. No
+    /// RPDO1 with the quick stop and its target (and torque limit) zeroed, then the SYNC that
+    /// applies them. No
     /// state changes: the next tick decides again.
     pub fn stop_frames(&mut self, out: &mut impl FnMut(CanFrame)) {
         for s in &mut self.slots {
@@ -382,45 +383,49 @@ impl DriveBank {
                 r.cw = Command::QuickStop.controlword();
             }
             if !matches!(s.phase, Phase::Starting(_)) {
-                let (cw, value) = stop();
-                out(rpdo1(s.settings.node, s.settings.mode, cw, value));
+                let (cw, sp) = stop();
+                out(rpdo1(s.settings.node, s.settings.mode, cw, sp));
             }
         }
         out(sync_frame_on(self.settings.sync_cob_id));
     }
 }
 
-/// The quick stop with the target zeroed.
-fn stop() -> (Controlword, i32) {
-    (Command::QuickStop.controlword(), 0)
+/// The quick stop with the target and the torque limit zeroed. A zero limit (CSV, PV) means
+/// the drive's ramp to standstill cannot push either: the finger is let go rather than held
+/// or braked by the motor, and no force reaches the fingertip that the last setpoint did not
+/// ask for (a stop may follow a stale or invalid setpoint, so no earlier limit is trusted).
+fn stop() -> (Controlword, Setpoint) {
+    (Command::QuickStop.controlword(), Setpoint::ZERO)
 }
 
 /// The RPDO1 content of a running drive for `target`; walks it back to Operation enabled
-/// by controlword (one command per observed statusword) when it was stopped.
+/// by controlword (one command per observed statusword) when it was stopped, target and
+/// torque limit zero meanwhile.
 fn run_step(
     r: &mut Run,
     target: Target,
     now_us: u64,
     step_timeout_us: u64,
-) -> Result<(Controlword, i32), DriveFault> {
-    let value = match target {
+) -> Result<(Controlword, Setpoint), DriveFault> {
+    let sp = match target {
         Target::Stop => {
             r.enabled = false;
             r.walk = None;
             r.cw = Command::QuickStop.controlword();
             return Ok(stop());
         }
-        Target::Run(v) => v,
+        Target::Run { value, max_torque } => Setpoint { value, max_torque },
     };
     if r.enabled {
         r.cw = Command::EnableOperation.controlword();
-        return Ok((r.cw, value));
+        return Ok((r.cw, sp));
     }
     let walk = r
         .walk
         .get_or_insert_with(|| PowerDriver::new(step_timeout_us));
     let Some(fb) = r.feedback else {
-        return Ok((r.cw, 0));
+        return Ok((r.cw, Setpoint::ZERO));
     };
     match walk.step(fb.statusword, now_us)? {
         DriverStep::Send(cw) => r.cw = cw,
@@ -429,10 +434,10 @@ fn run_step(
             r.enabled = true;
             r.walk = None;
             r.cw = Command::EnableOperation.controlword();
-            return Ok((r.cw, value));
+            return Ok((r.cw, sp));
         }
     }
-    Ok((r.cw, 0))
+    Ok((r.cw, Setpoint::ZERO))
 }
 
 /// What a TPDO1 statusword means for a running drive.

@@ -1,19 +1,73 @@
 //! The cyclic PDOs of a finger drive as fixed layouts (the mapping [`crate::pdo::finger_pdos`]
-//! writes at start-up): RPDO1 = controlword + target, TPDO1 = statusword + torque actual +
-//! velocity actual, TPDO2 = position actual. Encoded and decoded without allocation.
+//! writes at start-up): RPDO1 = controlword + target (+ max torque in the velocity modes),
+//! TPDO1 = statusword + torque actual + velocity actual, TPDO2 = position actual. Encoded and
+//! decoded without allocation.
 
 use crate::cia402::{Controlword, Mode, Statusword};
 use crate::frame::CanFrame;
 use crate::ids::{CobId, Function, NodeId};
+
+/// Max torque (0x6072, UNSIGNED16), per mille of rated torque: in CSV and PV the torque the
+/// drive's velocity loop may use, sent with the target each tick (the force-limited velocity
+/// of the native controller). Not sent in CST, whose target is the torque itself.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct TorqueLimit(pub u16);
+
+impl TorqueLimit {
+    /// No torque: what a stopped or not yet enabled drive gets.
+    pub const ZERO: Self = Self(0);
+}
 
 /// What a tick commands one drive, in the drive's units (per mille of rated torque in CST,
 /// rpm in CSV and PV).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Target {
     /// Follow this target (Operation enabled; the bank walks the drive there first).
-    Run(i32),
-    /// Quick stop with the target zeroed: handd's SAFE_STOP for a CiA 402 finger.
+    Run {
+        /// 0x6071 in CST, 0x60FF in CSV and PV.
+        value: i32,
+        /// 0x6072 in CSV and PV (ignored in CST).
+        max_torque: TorqueLimit,
+    },
+    /// Quick stop with the target and the torque limit zeroed: handd's SAFE_STOP for a CiA 402
+    /// finger.
     Stop,
+}
+
+impl Target {
+    /// `Run` with no torque limit to speak of ([`TorqueLimit::ZERO`]): a CST target.
+    pub const fn torque(permille: i32) -> Self {
+        Self::Run {
+            value: permille,
+            max_torque: TorqueLimit::ZERO,
+        }
+    }
+
+    /// `Run` with a velocity target (rpm) and its torque limit: a CSV or PV target.
+    pub const fn velocity(rpm: i32, max_torque: TorqueLimit) -> Self {
+        Self::Run {
+            value: rpm,
+            max_torque,
+        }
+    }
+}
+
+/// What one RPDO1 carries besides its controlword.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Setpoint {
+    /// 0x6071 in CST (saturated to i16), 0x60FF in CSV and PV.
+    pub value: i32,
+    /// 0x6072 in CSV and PV.
+    pub max_torque: TorqueLimit,
+}
+
+impl Setpoint {
+    /// Target and torque limit zeroed: the quick stop's, and a drive's being walked back to
+    /// Operation enabled.
+    pub const ZERO: Self = Self {
+        value: 0,
+        max_torque: TorqueLimit::ZERO,
+    };
 }
 
 /// The newest TPDO1 of a drive and when it arrived.
@@ -29,21 +83,23 @@ pub struct Feedback {
     pub at_us: u64,
 }
 
-/// RPDO1 (0x200 + node) carrying `cw` and `target`: 16-bit target torque in CST, 32-bit target
-/// velocity otherwise. A CST target outside i16 saturates.
-pub fn rpdo1(node: NodeId, mode: Mode, cw: Controlword, target: i32) -> CanFrame {
+/// RPDO1 (0x200 + node) carrying `cw` and `sp`: in CST the 16-bit target torque (4 bytes), in
+/// CSV and PV the 32-bit target velocity and the 16-bit max torque (8 bytes). A CST target
+/// outside i16 saturates.
+pub fn rpdo1(node: NodeId, mode: Mode, cw: Controlword, sp: Setpoint) -> CanFrame {
     let id = CobId::of(Function::Rpdo(1), node).map_or(0x200, CobId::raw);
     let mut d = [0u8; 8];
     d[..2].copy_from_slice(&cw.0.to_le_bytes());
     let len = match mode {
         Mode::CyclicSyncTorque => {
-            let t = target.clamp(i32::from(i16::MIN), i32::from(i16::MAX)) as i16;
+            let t = sp.value.clamp(i32::from(i16::MIN), i32::from(i16::MAX)) as i16;
             d[2..4].copy_from_slice(&t.to_le_bytes());
             4
         }
         Mode::CyclicSyncVelocity | Mode::ProfileVelocity => {
-            d[2..6].copy_from_slice(&target.to_le_bytes());
-            6
+            d[2..6].copy_from_slice(&sp.value.to_le_bytes());
+            d[6..8].copy_from_slice(&sp.max_torque.0.to_le_bytes());
+            8
         }
     };
     CanFrame::from_parts(id, len, d)
@@ -90,12 +146,29 @@ mod tests {
                 .iter()
                 .find(|p| p.direction == Direction::Rx && p.number == 1)
                 .expect("RPDO1");
-            for (cw, target) in [(0x000F_u16, -300_i32), (0x0002, 0), (0x0080, 1234)] {
-                let ours = rpdo1(node(), mode, Controlword(cw), target);
-                let general = rx
-                    .encode(&[u32::from(cw), target as u32])
-                    .expect("two entries");
-                assert_eq!(ours, general, "{mode:?} cw {cw:#06x} target {target}");
+            for (cw, value, limit) in [
+                (0x000F_u16, -300_i32, 450_u16),
+                (0x0002, 0, 0),
+                (0x0080, 1234, u16::MAX),
+            ] {
+                let sp = Setpoint {
+                    value,
+                    max_torque: TorqueLimit(limit),
+                };
+                let ours = rpdo1(node(), mode, Controlword(cw), sp);
+                let values: &[u32] = match mode {
+                    Mode::CyclicSyncTorque => &[u32::from(cw), value as u32],
+                    _ => &[u32::from(cw), value as u32, u32::from(limit)],
+                };
+                let general = rx.encode(values).expect("one value per entry");
+                assert_eq!(ours, general, "{mode:?} cw {cw:#06x} {sp:?}");
+                let masked: Vec<u32> = rx
+                    .entries
+                    .iter()
+                    .zip(values)
+                    .map(|(e, v)| v & (u32::MAX >> (32 - u32::from(e.bits))))
+                    .collect();
+                assert_eq!(rx.decode(&ours).expect("its own length"), masked);
             }
             let tx = pdos
                 .iter()
@@ -113,12 +186,71 @@ mod tests {
         }
     }
 
+    fn sp(value: i32, limit: u16) -> Setpoint {
+        Setpoint {
+            value,
+            max_torque: TorqueLimit(limit),
+        }
+    }
+
     #[test]
     fn a_cst_target_beyond_i16_saturates_rather_than_wrapping() {
-        let f = rpdo1(node(), Mode::CyclicSyncTorque, Controlword(0x0F), 40_000);
+        let f = rpdo1(
+            node(),
+            Mode::CyclicSyncTorque,
+            Controlword(0x0F),
+            sp(40_000, 0),
+        );
         assert_eq!(&f.payload()[2..4], &i16::MAX.to_le_bytes());
-        let f = rpdo1(node(), Mode::CyclicSyncTorque, Controlword(0x0F), -40_000);
+        let f = rpdo1(
+            node(),
+            Mode::CyclicSyncTorque,
+            Controlword(0x0F),
+            sp(-40_000, 0),
+        );
         assert_eq!(&f.payload()[2..4], &i16::MIN.to_le_bytes());
+    }
+
+    /// CSV and PV: controlword, target velocity, max torque, little-endian, 8 bytes on 0x200 +
+    /// node; CST: controlword and target torque, 4 bytes, the limit not sent.
+    #[test]
+    fn the_velocity_modes_carry_the_torque_limit_after_the_target() {
+        for mode in [Mode::CyclicSyncVelocity, Mode::ProfileVelocity] {
+            let f = rpdo1(node(), mode, Controlword(0x000F), sp(-70_000, 0x01F4));
+            assert_eq!(f.cob_id(), 0x209, "{mode:?}");
+            let v = (-70_000_i32).to_le_bytes();
+            assert_eq!(
+                f.payload(),
+                &[0x0F, 0x00, v[0], v[1], v[2], v[3], 0xF4, 0x01],
+                "{mode:?}"
+            );
+        }
+        let f = rpdo1(
+            node(),
+            Mode::CyclicSyncTorque,
+            Controlword(0x000F),
+            sp(-300, 0x01F4),
+        );
+        assert_eq!(f.payload(), &[0x0F, 0x00, 0xD4, 0xFE]);
+    }
+
+    #[test]
+    fn the_target_constructors_put_the_limit_where_the_mode_reads_it() {
+        assert_eq!(
+            Target::torque(250),
+            Target::Run {
+                value: 250,
+                max_torque: TorqueLimit::ZERO
+            }
+        );
+        assert_eq!(
+            Target::velocity(-1200, TorqueLimit(300)),
+            Target::Run {
+                value: -1200,
+                max_torque: TorqueLimit(300)
+            }
+        );
+        assert_eq!(Setpoint::ZERO, sp(0, 0));
     }
 
     #[test]

@@ -11,5 +11,5 @@ pub mod cyclic;
 pub mod fault;
 
 pub use bank::{BankError, BankSettings, DriveBank, DriveStatus};
-pub use cyclic::{Feedback, Target};
+pub use cyclic::{Feedback, Setpoint, Target, TorqueLimit};
 pub use fault::DriveFault;

@@ -161,6 +161,7 @@ pub const FINGER_DRIVE_OBJECTS: &[ObjectDef] = &[
     d(0x6064, 0, 4, true, Ro, true, 0),
     d(0x606C, 0, 4, true, Ro, true, 0),
     d(0x6071, 0, 2, true, Rw, true, 0),
+    d(0x6072, 0, 2, false, Rw, true, 1000),
     d(0x6076, 0, 4, false, Rw, false, 100),
     d(0x6077, 0, 2, true, Ro, true, 0),
     d(0x60C2, 0, 1, false, Const, false, 2),

@@ -1,10 +1,11 @@
 //! The CiA 402 fingers: `hand_canopen::DriveBank` inside the engine. Frames of the drives'
 //! COB-IDs go to the bank instead of hand.dbc's decoder; a CiA 402 finger's setpoint leaves as
-//! its RPDO1 (torque per mille in CST, rpm in CSV and PV, through the finger's scaling), then
-//! one SYNC and handd's CANopen heartbeat end the tick. Start-up SDO replies are answered at
-//! once ([`Engine::take_immediate`]), so a drive starts at bus speed, not one step per tick.
+//! its RPDO1 (torque per mille in CST, rpm and the force as max torque in CSV and PV, through
+//! the finger's scaling), then one SYNC and handd's CANopen heartbeat end the tick. Start-up
+//! SDO replies are answered at once ([`Engine::take_immediate`]), so a drive starts at bus
+//! speed, not one step per tick.
 
-use hand_canopen::master::{BankSettings, DriveBank, DriveStatus, Target};
+use hand_canopen::master::{BankSettings, DriveBank, DriveStatus, Target, TorqueLimit};
 use hand_canopen::{CobId, NodeId};
 use hand_dbc::CanFrame;
 
@@ -153,7 +154,9 @@ impl Drives {
         self.slot[f].map(|(k, _)| self.bank.status(k))
     }
 
-    /// Finger `f`'s setpoint as its drive's target: `None` stops it.
+    /// Finger `f`'s setpoint as its drive's target: `None` stops it. In CST the force is the
+    /// target torque; in CSV and PV the velocity is the target and the force's magnitude its
+    /// torque limit (0x6072), the native controller's force-limited velocity.
     pub(super) fn set_target(&mut self, f: usize, setpoint: Option<&Setpoint>) {
         let Some((k, scaling)) = self.slot[f] else {
             return;
@@ -162,10 +165,13 @@ impl Drives {
             None => Target::Stop,
             Some(sp) => match self.bank.mode(k) {
                 hand_canopen::Mode::CyclicSyncTorque => {
-                    Target::Run(i32::from(scaling.torque_permille(sp.force.0)))
+                    Target::torque(i32::from(scaling.torque_permille(sp.force.0)))
                 }
                 hand_canopen::Mode::CyclicSyncVelocity | hand_canopen::Mode::ProfileVelocity => {
-                    Target::Run(scaling.velocity_rpm(sp.velocity.0))
+                    Target::velocity(
+                        scaling.velocity_rpm(sp.velocity.0),
+                        TorqueLimit(scaling.max_torque_permille(sp.force.0)),
+                    )
                 }
             },
         };

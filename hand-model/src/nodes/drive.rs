@@ -8,7 +8,9 @@
 //!   finger moves toward it at up to its maximum speed, force-limited, and pushes with it when
 //!   blocked (the native controller's ACTIVE with that force and a saturated speed);
 //! - cyclic synchronous or profile velocity (9, 3): the speed is the target in rad/s at the
-//!   joint, with up to the finger's maximum force.
+//!   joint, with up to the finger's maximum force or the drive's max torque (0x6072) in N at the
+//!   fingertip, whichever is less (handd sends its force setpoint there each tick: the native
+//!   controller's force-limited velocity).
 //!
 //! In any other power state the finger is braked. The position actual value (0x6064) is the
 //! joint angle in milliradians.
@@ -200,7 +202,9 @@ impl DriveFingerNode {
             3 | 9 => {
                 let rpm = od.get_i32(ObjectAddr::new(objects::TARGET_VELOCITY, 0));
                 let v = self.scaling.rad_s(rpm);
-                (toward(v, self.cfg.max_force_n), v)
+                let limit = od.get(ObjectAddr::new(objects::MAX_TORQUE, 0)) as u16;
+                let f = self.cfg.max_force_n.min(self.scaling.limit_force_n(limit));
+                (toward(v, f), v)
             }
             _ => (0.0, 0.0),
         };
