@@ -93,6 +93,33 @@ fn heartbeat_ids(seen: &[Seen]) -> Vec<(u64, u32)> {
         .collect()
 }
 
+/// handd's state and faults from its HAND_HEARTBEAT frames in `[from, to)`, each change once:
+/// (ms after `zero`, state, the faults' names), to say why a span was not what it should be.
+fn daemon_states(seen: &[Seen], from: u64, to: u64, zero: u64) -> Vec<(i64, String, String)> {
+    let mut out: Vec<(i64, String, String)> = Vec::new();
+    for s in seen.iter().filter(|s| s.time_us >= from && s.time_us < to) {
+        let Some(hb) = s
+            .frame
+            .as_ref()
+            .filter(|f| f.raw_id() == HandHeartbeat::ID)
+            .and_then(|f| HandHeartbeat::decode(f.data()).ok())
+        else {
+            continue;
+        };
+        let names: Vec<&str> = driver::safety::Fault::ALL
+            .iter()
+            .filter(|f| hb.fault_mask() & f.bit() != 0)
+            .map(|f| f.name())
+            .collect();
+        let now = (format!("{:?}", hb.state()), names.join(","));
+        if out.last().is_none_or(|l| (&l.1, &l.2) != (&now.0, &now.1)) {
+            let ms = (s.time_us as i64 - zero as i64) / 1_000;
+            out.push((ms, now.0, now.1));
+        }
+    }
+    out
+}
+
 /// The sine scenario's length, s.
 const SIM_S: f64 = 16.0;
 
@@ -161,8 +188,8 @@ fn deploy_refuses_bad_models_swaps_a_good_one_and_rolls_back() {
         rearmed,
         to: rearmed + 1_500_000,
     };
-    check(&seen, &times, (id_a, id_b));
     println!("deploy: during the refusals, the swap and the rollback: {judged}");
+    check(&seen, &times, (id_a, id_b));
     assert_eq!(judged.handd, 0, "a tick was missed: {judged}");
     assert_eq!(after.model.map(|m| m.id), Some(format!("{id_a:08x}")));
 }
@@ -270,7 +297,12 @@ fn check(seen: &[Seen], t: &Times, (a, b): (u32, u32)) {
             m.len(),
             all(&m, want)
         );
-        assert!(all(&m, want), "{what}: want only {want:?}, got {m:?}");
+        assert!(
+            all(&m, want),
+            "{what}: want only {want:?}, got {m:?}; handd's HAND_HEARTBEAT in that span (ms from \
+             the refusals' start, state, faults), each change: {:?}",
+            daemon_states(seen, from, to, t.from)
+        );
     }
     // Where the longest gap fell among the steps (a missed tick shows as one): ms from the
     // refusals' start (2 s into the scenario) to the gap and to each step.
