@@ -286,6 +286,20 @@ impl std::fmt::Display for Judged {
     }
 }
 
+/// Frames the kernel dropped from its per-CPU receive backlogs (`/proc/net/softnet_stat`,
+/// second column, summed over the CPUs): a frame a sender put on vcan that no socket got,
+/// because the softirqs that deliver it fell behind. `None` where the file cannot be read.
+pub fn softnet_drops() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/net/softnet_stat").ok()?;
+    text.lines()
+        .map(|l| {
+            l.split_whitespace()
+                .nth(1)
+                .and_then(|h| u64::from_str_radix(h, 16).ok())
+        })
+        .sum()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 use driver::live::Live;
 
 use handstack_tests::vcan::procs::DEADLINE_SLACK_MS;
-use handstack_tests::vcan::stall::StallMeter;
+use handstack_tests::vcan::stall::{softnet_drops, StallMeter};
 
 use super::Rig;
 
@@ -65,6 +65,7 @@ fn h_twenty_subscribers_ten_stuck_no_deadline_miss() {
     std::thread::sleep(Duration::from_millis(2_000));
     let meter = StallMeter::start();
     let st0 = rig.cfg.status(&rig.env);
+    let softnet0 = softnet_drops();
     let socket = rig.cfg.socket.clone();
 
     let until = Instant::now() + Duration::from_secs(4);
@@ -78,9 +79,12 @@ fn h_twenty_subscribers_ten_stuck_no_deadline_miss() {
         })
         .collect();
 
-    for (i, r) in readers.into_iter().enumerate() {
-        check_reader(i, &r.join().expect("reader"));
-    }
+    // Judged after what the run's other parties say (below), so a failure says where lost
+    // frames went.
+    let lines: Vec<Vec<Live>> = readers
+        .into_iter()
+        .map(|r| r.join().expect("reader"))
+        .collect();
     for (i, mut s) in stuck.into_iter().enumerate() {
         s.set_read_timeout(Some(Duration::from_secs(3)))
             .expect("timeout");
@@ -93,6 +97,34 @@ fn h_twenty_subscribers_ten_stuck_no_deadline_miss() {
         .stop()
         .judge(&st0, &st, u64::from(DEADLINE_SLACK_MS) * 1_000);
     sim.wait_success(Duration::from_secs(60));
+    // Where EMG frames can be lost between handsim's amplifier and handd: refused by vcan's
+    // transmit queue or skipped by a stalled handsim (handsim's own count), dropped from the
+    // kernel's receive backlog (softnet), or from handd's socket (its kernel_drops).
+    let amp = sim
+        .output()
+        .lines()
+        .find(|l| l.contains("amplifier transmits refused"))
+        .unwrap_or("handsim printed no amplifier line")
+        .to_owned();
+    let softnet = softnet0
+        .zip(softnet_drops())
+        .map(|(a, b)| (b - a).to_string());
+    println!(
+        "subscribers: EMG on the way to handd: {amp}; the kernel's receive backlog dropped {} \
+         frames; handd's socket {}; handd lost {} samples, {} E2E errors",
+        softnet.as_deref().unwrap_or("(unreadable)"),
+        st.bus.counters.kernel_drops,
+        st.samples_lost,
+        lines
+            .iter()
+            .filter_map(|l| l.last())
+            .map(|l| l.counters.e2e_errors)
+            .max()
+            .unwrap_or(0)
+    );
+    for (i, l) in lines.iter().enumerate() {
+        check_reader(i, l);
+    }
     let dropped = rig
         .handd
         .output()
