@@ -22,9 +22,9 @@ const TRIPPED: usize = 3;
 /// The tracked finger (the index's drive, node 6).
 const TRACKED: usize = 1;
 /// The ring's drive trips this long after handsim started, s.
-const TRIP_S: f64 = 18.0;
+const TRIP_S: f64 = 13.0;
 /// handsim's run, s (handd is killed before its end, so the drives' watchdogs are seen).
-const RUN_S: f64 = 27.0;
+const RUN_S: f64 = 22.0;
 /// The tracking is scored from this long after every drive follows its setpoint (the native
 /// closed loop's settling from the scenario's start, where its fingers follow at once).
 const SETTLE_US: u64 = 4_000_000;
