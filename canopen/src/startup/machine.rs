@@ -308,6 +308,17 @@ impl Startup {
             SdoDone::Uploaded(d) => Some(d),
             SdoDone::Downloaded => None,
         };
+        self.on_transfer_done(step, data, now_us)
+    }
+
+    /// The step's SDO transfer finished (`data` for an upload): check it and move on; may
+    /// return a frame to send at once (the enable walk's next request).
+    fn on_transfer_done(
+        &mut self,
+        step: Step,
+        data: Option<SdoData>,
+        now_us: u64,
+    ) -> Option<CanFrame> {
         match (step, data) {
             (Step::ReadIdentity(sub), Some(d)) => {
                 let v = d.as_u32();
