@@ -7,6 +7,7 @@ pub mod monitor;
 pub mod procs;
 pub mod replay;
 pub mod stall;
+pub mod stream_breaks;
 
 pub use analysis::{
     first_safe_stop_after, scenario_start_us, setpoints_of, statuses_of, SetpointRecord,

@@ -805,6 +805,11 @@ fn d7_interface_down_and_up() {
     let mut rig = Rig::start("link-down", DRILL_SILENCE_MS);
     let mut sim = rig.sim("sine", RUN_S, &[]);
     std::thread::sleep(Duration::from_millis(2_500));
+    // The drill needs handd RUNNING when the link goes down: a stop the simulated amplifier's
+    // stream caused just before (`stream_breaks`) would leave nothing to check, so wait out
+    // its recovery first.
+    restart::wait_active_after(&rig.monitor, now_us(), Duration::from_secs(3))
+        .expect("handd RUNNING before the link goes down");
     let down_at = now_us();
     rig.env.link("down");
     // `ip link set down` runs as a child process: frames handd sent while it started (tens of
