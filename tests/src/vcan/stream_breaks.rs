@@ -90,6 +90,41 @@ pub fn emg_silences(seen: &[Seen], min_us: u64) -> Vec<EmgSilence> {
     out
 }
 
+/// A silence of the amplifier's frames at least this long, resumed in sequence, is time the
+/// simulated world stood still (they come every 1 ms), µs.
+pub const STALL_MIN_US: u64 = 5_000;
+
+/// The silences of the amplifier's frames that lie within `[from_us, to_us]`, over
+/// [`STALL_MIN_US`] and resumed in sequence (the amplifier ran: the guest stood still), and
+/// the time they took beyond the 1 ms the frames come at, µs. A bar on what handd does in
+/// that span counts the time the simulated world ran: this is what to take out of it.
+pub fn stalled_within(seen: &[Seen], from_us: u64, to_us: u64) -> (Vec<EmgSilence>, u64) {
+    let silences: Vec<EmgSilence> = emg_silences(seen, STALL_MIN_US)
+        .into_iter()
+        .filter(|s| s.in_sequence && s.from_us >= from_us && s.to_us <= to_us)
+        .collect();
+    let us = silences.iter().map(|s| s.len_us() - 1_000).sum();
+    (silences, us)
+}
+
+/// `seen` with the wall-clock step of `step_us` taken out of its stamps: every stamp from the
+/// first that jumps by more than half the step (in its direction) on is moved back by it, so
+/// a silence across the step has its length again. Kernel stamps follow the wall clock.
+pub fn unstepped(seen: &[Seen], step_us: i64) -> Vec<Seen> {
+    let half = step_us.unsigned_abs() / 2;
+    let at = seen.windows(2).position(|w| {
+        let d = w[1].time_us as i64 - w[0].time_us as i64;
+        d.signum() == step_us.signum() && d.unsigned_abs() > half
+    });
+    let mut out = seen.to_vec();
+    if let Some(i) = at {
+        for s in &mut out[i + 1..] {
+            s.time_us = (s.time_us as i64 - step_us) as u64;
+        }
+    }
+    out
+}
+
 /// A stretch of setpoints that were not ACTIVE, and what the bus says of it.
 #[derive(Debug, Clone)]
 pub struct Stretch {
@@ -130,34 +165,46 @@ impl std::fmt::Display for Stretch {
     }
 }
 
-/// The stretches of `fingers`' setpoints in `[from_us, to_us)` that were not ACTIVE, each
-/// judged as the module says.
+/// The stretches of `fingers`' setpoints that were not ACTIVE and reach into
+/// `[from_us, to_us)`, each judged as the module says. A stretch is taken whole, from its
+/// first such setpoint to its last, also where it began before `from_us`: its onset is what
+/// the bus must explain.
 pub fn judge_not_active(seen: &[Seen], from_us: u64, to_us: u64, fingers: &[usize]) -> Verdict {
     let mut stretches: Vec<(u64, u64)> = Vec::new();
-    for sp in setpoints_of(seen).iter().filter(|s| {
-        s.time_us >= from_us
-            && s.time_us < to_us
-            && fingers.contains(&s.finger)
-            && s.mode != FingerMode::Active
-    }) {
+    let mut last_active: Option<u64> = None;
+    for sp in setpoints_of(seen)
+        .iter()
+        .filter(|s| fingers.contains(&s.finger))
+    {
+        if sp.mode == FingerMode::Active {
+            last_active = Some(sp.time_us);
+            continue;
+        }
         match stretches.last_mut() {
-            Some(last) if sp.time_us.abs_diff(last.1) <= STRETCH_JOIN_US => last.1 = sp.time_us,
+            // Joined unless an ACTIVE setpoint came between, or too long a pause.
+            Some(last)
+                if sp.time_us.abs_diff(last.1) <= STRETCH_JOIN_US
+                    && last_active.is_none_or(|t| t < last.0) =>
+            {
+                last.1 = sp.time_us
+            }
             _ => stretches.push((sp.time_us, sp.time_us)),
         }
     }
     let silences = emg_silences(seen, GAP_LIMIT_US);
     let stretches = stretches
         .into_iter()
-        .map(|(a, b)| judge(seen, &silences, a, b))
+        .filter(|&(a, b)| b >= from_us && a < to_us)
+        .map(|stretch| judge(seen, &silences, stretch, ONSET_US))
         .collect();
     Verdict { stretches }
 }
 
-fn judge(seen: &[Seen], silences: &[EmgSilence], a: u64, b: u64) -> Stretch {
+fn judge(seen: &[Seen], silences: &[EmgSilence], (a, b): (u64, u64), onset_us: u64) -> Stretch {
     let mut names: Vec<&'static str> = Vec::new();
     for s in seen
         .iter()
-        .filter(|s| s.time_us + 60_000 >= a && s.time_us <= b + 60_000)
+        .filter(|s| s.time_us + 110_000 >= a && s.time_us <= b + 110_000)
     {
         let Some(hb) = s
             .frame
@@ -191,13 +238,13 @@ fn judge(seen: &[Seen], silences: &[EmgSilence], a: u64, b: u64) -> Stretch {
     } else {
         let near = silences
             .iter()
-            .find(|s| s.to_us <= a + 5_000 && a <= s.to_us + ONSET_US);
+            .find(|s| s.to_us <= a + 5_000 && a <= s.to_us + onset_us);
         match near {
             None => {
                 st.why = format!(
                     "no EMG silence over {} ms ended in the {} ms before it",
                     GAP_LIMIT_US / 1000,
-                    ONSET_US / 1000
+                    onset_us / 1000
                 )
             }
             Some(s) if s.len_us() > MAX_EXCUSED_SILENCE_US => {
@@ -218,6 +265,43 @@ fn judge(seen: &[Seen], silences: &[EmgSilence], a: u64, b: u64) -> Stretch {
     st
 }
 
+/// [`judge_not_active`] for a bus without FINGER_SETPOINT (every finger on a CiA 402 drive):
+/// the stretches are those of HAND_HEARTBEAT not Running. It is sent every 100 ms, so the
+/// stop may show up to one heartbeat period later than it began.
+pub fn judge_not_running(seen: &[Seen], from_us: u64, to_us: u64) -> Verdict {
+    let mut stretches: Vec<(u64, u64)> = Vec::new();
+    let mut running_since_last = true;
+    for s in seen {
+        let Some(hb) = s
+            .frame
+            .as_ref()
+            .filter(|f| f.raw_id() == HandHeartbeat::ID)
+            .and_then(|f| HandHeartbeat::decode(f.data()).ok())
+        else {
+            continue;
+        };
+        if hb.state() == DaemonState::Running {
+            running_since_last = true;
+            continue;
+        }
+        match stretches.last_mut() {
+            Some(last) if !running_since_last => last.1 = s.time_us,
+            _ => stretches.push((s.time_us, s.time_us)),
+        }
+        running_since_last = false;
+    }
+    let silences = emg_silences(seen, GAP_LIMIT_US);
+    let stretches = stretches
+        .into_iter()
+        .filter(|&(a, b)| b >= from_us && a < to_us)
+        .map(|stretch| judge(seen, &silences, stretch, ONSET_US + HEARTBEAT_PERIOD_US))
+        .collect();
+    Verdict { stretches }
+}
+
+/// HAND_HEARTBEAT's period (hand.dbc), µs.
+const HEARTBEAT_PERIOD_US: u64 = 100_000;
+
 /// What [`judge_not_active`] found.
 #[derive(Debug, Clone, Default)]
 pub struct Verdict {
@@ -228,9 +312,15 @@ pub struct Verdict {
 impl Verdict {
     /// Whether a setpoint at `t_us` lies in an excused stretch.
     pub fn excuses(&self, t_us: u64) -> bool {
+        self.excuses_within(t_us, 0)
+    }
+
+    /// Whether `t_us` lies in an excused stretch or up to `after_us` after its end (what
+    /// follows the stop for a while, e.g. a drive's way back to Operation enabled).
+    pub fn excuses_within(&self, t_us: u64, after_us: u64) -> bool {
         self.stretches
             .iter()
-            .any(|s| s.silence.is_some() && s.from_us <= t_us && t_us <= s.to_us)
+            .any(|s| s.silence.is_some() && s.from_us <= t_us && t_us <= s.to_us + after_us)
     }
 
     /// Whether the newest stretch is excused and reaches `t_us` (within a tick): a stop the
@@ -277,6 +367,103 @@ mod tests {
         }
     }
 
+    fn frame(t: u64, id: u32, data: &[u8]) -> Seen {
+        Seen {
+            time_us: t,
+            frame: Some(CanFrame::new_standard(id as u16, data).expect("frame")),
+            read_us: t,
+            socket: 0,
+        }
+    }
+
+    /// Two seconds of a hand: EMG every 1 ms but silent from 300 ms to `resume_ms` (resumed
+    /// with `lost` samples skipped), every finger's setpoint every 50 ms (SAFE_STOP from
+    /// `stop_ms` to `run_ms`), HAND_HEARTBEAT every 100 ms (Safe with `faults` while stopped).
+    fn hand(resume_ms: u64, lost: u8, (stop_ms, run_ms): (u64, u64), faults: u16) -> Vec<Seen> {
+        use hand_dbc::messages::{FingerSetpoint, HandHeartbeat};
+        let mut seen = Vec::new();
+        let mut counter = 0u8;
+        for ms in 0..2_000u64 {
+            let t = ms * 1000;
+            if ms <= 300 || ms >= resume_ms {
+                if ms == resume_ms {
+                    counter = counter.wrapping_add(lost);
+                }
+                seen.push(emg(t + 10, counter));
+                counter = counter.wrapping_add(1);
+            }
+            let stopped = ms >= stop_ms && ms < run_ms;
+            if ms % 50 == 0 && (ms <= 300 || ms >= resume_ms) {
+                let mode = if stopped {
+                    FingerMode::SafeStop
+                } else {
+                    FingerMode::Active
+                };
+                for f in 0..5 {
+                    let sp = FingerSetpoint::new(f, mode, 0.0, 0.0, 1).expect("setpoint");
+                    seen.push(frame(t + 500, FingerSetpoint::IDS[f], &sp.encode()));
+                }
+            }
+            if ms % 100 == 0 && (ms <= 300 || ms >= resume_ms) {
+                let (state, mask) = if stopped {
+                    (DaemonState::Safe, faults)
+                } else {
+                    (DaemonState::Running, 0)
+                };
+                let hb = HandHeartbeat::new(state, mask, 1).expect("heartbeat");
+                seen.push(frame(t + 600, HandHeartbeat::ID, &hb.encode()));
+            }
+        }
+        seen
+    }
+
+    fn bit(name: &str) -> u16 {
+        driver::safety::Fault::ALL
+            .iter()
+            .find(|f| f.name() == name)
+            .expect("a fault")
+            .bit()
+    }
+
+    #[test]
+    fn a_stop_right_after_a_stall_for_its_recovery_time_is_excused_and_nothing_else_is() {
+        let window = bit("invalid_window");
+        // The stall: 60 ms silent, resumed in sequence; handd stops at once for 500 ms.
+        let v = judge_not_active(
+            &hand(360, 0, (360, 900), window),
+            0,
+            2_000_000,
+            &[0, 1, 2, 3, 4],
+        );
+        assert_eq!(v.stretches.len(), 1, "{}", v.lines());
+        assert!(v.stretches[0].silence.is_some(), "{}", v.lines());
+        assert!(v.excuses(500_000) && !v.excuses(950_000));
+        // Samples lost in the silence: not a stall.
+        let v = judge_not_active(&hand(360, 30, (360, 900), window), 0, 2_000_000, &[0]);
+        assert!(v.unexcused().count() == 1, "{}", v.lines());
+        // Another fault named.
+        let v = judge_not_active(
+            &hand(360, 0, (360, 900), window | bit("estop")),
+            0,
+            2_000_000,
+            &[0],
+        );
+        assert!(v.unexcused().count() == 1, "{}", v.lines());
+        // Longer than the recovery after it.
+        let v = judge_not_active(&hand(360, 0, (360, 1_400), window), 0, 2_000_000, &[0]);
+        assert!(v.unexcused().count() == 1, "{}", v.lines());
+        // A stop with no silence before it.
+        let v = judge_not_active(&hand(301, 0, (600, 1_100), window), 0, 2_000_000, &[0]);
+        assert!(v.unexcused().count() == 1, "{}", v.lines());
+        // The same from HAND_HEARTBEAT alone.
+        let v = judge_not_running(&hand(360, 0, (360, 900), window), 0, 2_000_000);
+        assert!(
+            v.stretches.len() == 1 && v.unexcused().count() == 0,
+            "{}",
+            v.lines()
+        );
+    }
+
     #[test]
     fn a_late_resume_is_a_silence_in_sequence_and_a_lost_sample_is_not() {
         let mut seen: Vec<Seen> = (0..10u8).map(|c| emg(u64::from(c) * 1000, c)).collect();
@@ -290,5 +477,24 @@ mod tests {
             (9_000, 48_000, true)
         );
         assert!(!s[1].in_sequence);
+    }
+
+    #[test]
+    fn a_silence_across_a_clock_step_keeps_its_length_once_unstepped() {
+        const HOUR: i64 = 3_600_000_000;
+        let base = 10 * HOUR as u64;
+        let mut seen: Vec<Seen> = (0..10u8)
+            .map(|c| emg(base + u64::from(c) * 1000, c))
+            .collect();
+        // 60 ms silent, and the wall clock stepped back an hour meanwhile.
+        seen.push(emg(base + 69_000 - HOUR as u64, 10));
+        assert!(emg_silences(&seen, GAP_LIMIT_US).is_empty());
+        let s = emg_silences(&unstepped(&seen, -HOUR), GAP_LIMIT_US);
+        assert_eq!(s.len(), 1, "{s:?}");
+        assert_eq!((s[0].len_us(), s[0].in_sequence), (60_000, true));
+        // Forwards by two hours: the same.
+        seen[10].time_us = base + 69_000 + 2 * HOUR as u64;
+        let s = emg_silences(&unstepped(&seen, 2 * HOUR), GAP_LIMIT_US);
+        assert_eq!(s[0].len_us(), 60_000);
     }
 }

@@ -12,7 +12,10 @@ use std::path::Path;
 
 use handstack_tests::vcan::monitor::now_us;
 use handstack_tests::vcan::procs::handctl;
-use handstack_tests::vcan::VcanEnv;
+use handstack_tests::vcan::stream_breaks::{
+    stalled_within, GAP_LIMIT_US, MAX_EXCUSED_SILENCE_US, STALL_MIN_US,
+};
+use handstack_tests::vcan::{Seen, VcanEnv};
 
 /// Arming restarts the recovery time, so ACTIVE setpoints come back no sooner than this after
 /// `handctl arm` was started...
@@ -55,15 +58,37 @@ impl Armed {
     /// Asserts that the first ACTIVE setpoint after the arm (`resumed_us`) came by the recovery
     /// rule: not before the recovery time, not later than [`ARM_BAR_US`] after the answer.
     /// Prints both intervals under `what`.
-    pub(super) fn check(&self, what: &str, resumed_us: u64) {
+    ///
+    /// The bar counts the time the simulated world ran (`seen`, the bus): where the amplifier's
+    /// frames stood still in between (the guest stalled: `stream_breaks`), that time is taken
+    /// out, and a silence over the gap limit restarts the recovery time as handd must, so the
+    /// bar then runs from its end. Both are printed.
+    pub(super) fn check(&self, what: &str, resumed_us: u64, seen: &[Seen]) {
         let after_sent = resumed_us as i64 - self.sent_us as i64;
-        let after_answer = resumed_us as i64 - self.answered_us as i64;
+        let (silences, _) = stalled_within(seen, self.answered_us, resumed_us);
+        let restart = silences
+            .iter()
+            .filter(|s| s.len_us() > GAP_LIMIT_US && s.len_us() <= MAX_EXCUSED_SILENCE_US)
+            .map(|s| s.to_us)
+            .max();
+        let from = restart.unwrap_or(self.answered_us);
+        let (_, stalled) = stalled_within(seen, from, resumed_us);
+        let after_answer = resumed_us as i64 - from as i64 - stalled as i64;
         println!(
             "{what}: ACTIVE again {:.1} ms after `handctl arm` started, {:.1} ms after handd \
-             answered it ({:.1} ms to answer)",
+             answered it ({:.1} ms to answer); the amplifier's frames stood still {:.1} ms of it \
+             ({} silences over {} ms{}), so {:.1} ms against the bar",
             after_sent as f64 * 1e-3,
-            after_answer as f64 * 1e-3,
-            (self.answered_us - self.sent_us) as f64 * 1e-3
+            (resumed_us as i64 - self.answered_us as i64) as f64 * 1e-3,
+            (self.answered_us - self.sent_us) as f64 * 1e-3,
+            silences.iter().map(|s| s.len_us()).sum::<u64>() as f64 * 1e-3,
+            silences.len(),
+            STALL_MIN_US / 1000,
+            restart.map_or(String::new(), |t| format!(
+                "; one over the gap limit restarted the recovery, {:.1} ms after the answer",
+                (t - self.answered_us) as f64 * 1e-3
+            )),
+            after_answer as f64 * 1e-3
         );
         assert!(
             after_sent >= ARM_MIN_US as i64,

@@ -16,6 +16,7 @@ use driver::protocol::DriveLine;
 use hand_dbc::messages::FingerSetpoint;
 use handstack_tests::vcan::monitor::{now_us, writer};
 use handstack_tests::vcan::procs::handsim;
+use handstack_tests::vcan::stream_breaks::judge_not_active;
 use handstack_tests::vcan::{Monitor, TestConfig, VcanEnv};
 use socketcan::Socket;
 
@@ -257,8 +258,20 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
         "{} RPDO1 in the second before the kill",
         rpdos.len()
     );
+    // A stop the simulated amplifier's stream caused (`stream_breaks`, told from the native
+    // fingers' setpoints) quick-stops the drive too; it and the drive's three ticks back to
+    // Enable operation are excused, and printed. Any other control word still fails.
+    let verdict = judge_not_active(&seen, kill_at - 1_000_000, kill_at, &[0, 2, 3, 4]);
+    if !verdict.stretches.is_empty() {
+        println!(
+            "cia402: stretches not ACTIVE in the second before the kill:\n{}",
+            verdict.lines()
+        );
+    }
     assert!(
-        rpdos.iter().all(|f| f.2[..2] == [0x0F, 0x00]),
+        rpdos
+            .iter()
+            .all(|f| f.2[..2] == [0x0F, 0x00] || verdict.excuses_within(f.0, 3 * 50_000)),
         "Enable operation in every RPDO1: {rpdos:?}"
     );
     for r in &rpdos {

@@ -12,6 +12,7 @@ use hand_model::nodes::DriveFingerConfig;
 use hand_model::patient::{Target, TrackingConfig};
 use handstack_tests::vcan::monitor::now_us;
 use handstack_tests::vcan::procs::handsim;
+use handstack_tests::vcan::stream_breaks::judge_not_running;
 use handstack_tests::vcan::{scenario_start_us, Monitor, TestConfig, VcanEnv};
 
 use super::calibrated_model;
@@ -28,6 +29,9 @@ const RUN_S: f64 = 22.0;
 /// The tracking is scored from this long after every drive follows its setpoint (the native
 /// closed loop's settling from the scenario's start, where its fingers follow at once).
 const SETTLE_US: u64 = 4_000_000;
+/// Not scored after an excused stop (`stream_breaks`): the drives' three ticks back to
+/// Operation enabled and the patient's finger back on the sine, µs.
+const EXCUSED_SETTLE_US: u64 = 1_000_000;
 /// The CiA 402 state line of a drive that follows its setpoint.
 const FOLLOWING: &str = "Operation enabled, following";
 
@@ -182,15 +186,36 @@ fn j_every_finger_on_a_drive_tracks_one_trips_alone_and_all_stop_on_their_watchd
     let full_scale = TrackingConfig::default().full_scale_force_n;
     let (mut target, mut tracked) = (Vec::new(), Vec::new());
     let scored_from = following_at + SETTLE_US;
+    // A stop the simulated amplifier's stream caused (`stream_breaks`, from HAND_HEARTBEAT:
+    // no finger has a FINGER_SETPOINT here) quick-stops every drive; it and the second after it
+    // (the drives back to Operation enabled, the patient's finger back on the sine) are not
+    // scored, and printed. Any other stop is scored as before.
+    let verdict = judge_not_running(&seen, scored_from, kill_at);
+    if !verdict.stretches.is_empty() {
+        println!(
+            "cia402 hand: handd not RUNNING while scored:\n{}",
+            verdict.lines()
+        );
+    }
+    let mut unscored = 0;
     for f in of(0x180 + node(TRACKED), scored_from, kill_at) {
+        if verdict.excuses_within(f.0, EXCUSED_SETTLE_US) {
+            unscored += 1;
+            continue;
+        }
         let permille = i16::from_le_bytes([f.2[2], f.2[3]]);
         target.push(Target::SINE_4S.at(f.0 - start));
         tracked.push(scaling.force_n(permille) / full_scale);
     }
     let span_s = (kill_at - scored_from) as f64 * 1e-6;
+    println!(
+        "cia402 hand: {unscored} index TPDO1 not scored (in or within {} ms after an excused stop)",
+        EXCUSED_SETTLE_US / 1000
+    );
     assert!(
-        target.len() as f64 >= 18.0 * span_s,
-        "only {} index TPDO1 in {span_s:.1} s of tracking",
+        target.len() as f64 >= 0.6 * 20.0 * span_s,
+        "only {} index TPDO1 scored in {span_s:.1} s of tracking ({unscored} not scored after \
+         excused stops): too little to score",
         target.len()
     );
     let m = decoder::eval::tracking_metrics(&target, &tracked).expect("metrics");

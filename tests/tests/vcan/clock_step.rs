@@ -14,7 +14,7 @@ use std::time::{Duration, Instant, SystemTime, UNIX_EPOCH};
 
 use hand_dbc::messages::{FingerMode, HandEstop};
 use handstack_tests::vcan::monitor::now_us;
-use handstack_tests::vcan::stream_breaks::judge_not_active;
+use handstack_tests::vcan::stream_breaks::{judge_not_active, unstepped};
 use handstack_tests::vcan::{first_safe_stop_after, setpoints_of};
 
 use super::arming::Armed;
@@ -69,7 +69,10 @@ fn field_clock_steps_keep_handd_running_and_reacting() {
         .expect("handd never RUNNING before the steps");
     std::thread::sleep(Duration::from_millis(1_000));
     let clock = SteppedClock::new();
+    let mut offset_before = 0;
     for (offset_s, what) in [(-HOUR_S, "-1 h"), (HOUR_S, "+1 h (a +2 h step)")] {
+        let step_us = (offset_s - offset_before) * 1_000_000;
+        offset_before = offset_s;
         let from = rig.monitor.snapshot().len();
         clock.set(offset_s);
         std::thread::sleep(Duration::from_millis(1_500));
@@ -78,12 +81,14 @@ fn field_clock_steps_keep_handd_running_and_reacting() {
         let sps = setpoints_of(&seen[from..]);
         // A stop the simulated amplifier's stream caused is excused, and printed
         // (`stream_breaks`); any other setpoint not ACTIVE still fails.
-        let verdict = judge_not_active(&seen[from..], 0, u64::MAX, &ALL);
-        let stopped = sps
+        // Judged on the stamps with the step taken out, or a silence across it would not show.
+        let unstepped = unstepped(&seen[from..], step_us);
+        let verdict = judge_not_active(&unstepped, 0, u64::MAX, &ALL);
+        let stopped = setpoints_of(&unstepped)
             .iter()
             .filter(|s| s.mode != FingerMode::Active && !verdict.excuses(s.time_us))
             .count();
-        let last_sp = sps.last().map_or(0, |s| s.time_us);
+        let last_sp = setpoints_of(&unstepped).last().map_or(0, |s| s.time_us);
         let excused_now = verdict.ends_excused_at(last_sp)
             && st
                 .faults
@@ -165,7 +170,7 @@ fn field_clock_steps_keep_handd_running_and_reacting() {
     let armed = Armed::now(&rig.env, &rig.cfg.socket);
     let resumed = wait_active_after(&rig.monitor, armed.sent_us, Duration::from_secs(3))
         .expect("clock +1 h: never ACTIVE again after `handctl arm`");
-    armed.check("clock +1 h", resumed);
+    armed.check("clock +1 h", resumed, &rig.monitor.snapshot());
     std::thread::sleep(Duration::from_millis(500));
 
     // Amplifier silence: handsim (the amplifier and the finger controllers) stops.

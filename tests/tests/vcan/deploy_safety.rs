@@ -228,7 +228,7 @@ fn h1_a_second_setpoint_sender_latches_second_master_until_arm() {
         "second master: `handctl status` does not name second_master while latched: {}",
         latched.faults
     );
-    armed.check("drill second-master", resumed);
+    armed.check("drill second-master", resumed, &seen);
     assert!(
         !after.faults.split(',').any(|f| f == "second_master"),
         "second master: still latched after `handctl arm`: {}",

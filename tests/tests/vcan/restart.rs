@@ -156,7 +156,11 @@ fn arm_and_run(rig: &Rig, case: &str, killed_at: u64) {
         "{case}: ACTIVE {} us before `handctl arm`",
         armed.sent_us - resumed
     );
-    armed.check(&format!("restart after SIGKILL ({case})"), resumed);
+    armed.check(
+        &format!("restart after SIGKILL ({case})"),
+        resumed,
+        &rig.monitor.snapshot(),
+    );
 }
 
 #[test]

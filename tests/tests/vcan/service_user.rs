@@ -207,7 +207,11 @@ fn field_handd_as_the_handstack_user_tunes_deploys_and_rolls_back() {
     });
     let resumed = wait_active_after(&monitor, armed.sent_us, Duration::from_secs(3))
         .expect("never ACTIVE after the rollback and arm");
-    armed.check("as handstack, after the rollback", resumed);
+    armed.check(
+        "as handstack, after the rollback",
+        resumed,
+        &monitor.snapshot(),
+    );
 
     // What handd wrote is handstack's, and the rewritten config keeps the install's mode.
     for (p, what) in [
