@@ -26,7 +26,7 @@ use crate::bus_load::BusLoad;
 use crate::conditioner::{FingerGains, Setpoint};
 use crate::engine::{AmpProblem, Command, Counters, Engine};
 use crate::protocol::{LateTick, LATE_TICKS_KEPT};
-use crate::safety::{DaemonState, Fault, FaultSet, FingerEvent};
+use crate::safety::{Cause, DaemonState, Fault, FaultSet, FingerEvent};
 use crate::stats::Percentiles;
 use crate::transport::{BusHealth, ControllerState, Transport, TransportError};
 use crate::units::{FINGER_NAMES, N_FINGERS};
@@ -46,6 +46,8 @@ pub struct Snapshot {
     pub state: DaemonState,
     /// Faults in force.
     pub faults: FaultSet,
+    /// Why the window could not drive the fingers at this tick (None: it could).
+    pub window: Option<crate::engine::WindowProblem>,
     /// Counters since start.
     pub counters: Counters,
     /// Newest sample frame -> setpoints written.
@@ -116,6 +118,7 @@ impl Default for Snapshot {
         Self {
             state: DaemonState::Boot,
             faults: FaultSet::default(),
+            window: None,
             counters: Counters::default(),
             latency: Percentiles::default(),
             compute: Percentiles::default(),
@@ -655,8 +658,13 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             self.bus_failed(t1, &e);
         }
         self.engine.written(t1, t1.saturating_sub(t0));
+        // Why an invalid window was invalid: named on the state change it causes.
+        let window = self.engine.window_problem();
         self.engine.drain_events(
-            |t| tracing::info!(from = %t.from, to = %t.to, cause = %t.cause, at_us = t.at_us, "state change"),
+            |t| match (t.cause, window) {
+                (Cause::Fault(Fault::InvalidWindow), Some(w)) => tracing::info!(from = %t.from, to = %t.to, cause = %t.cause, window = %w, at_us = t.at_us, "state change"),
+                _ => tracing::info!(from = %t.from, to = %t.to, cause = %t.cause, at_us = t.at_us, "state change"),
+            },
             |e| match e {
                 FingerEvent::Disabled(f) => tracing::warn!(finger = FINGER_NAMES[f], "finger controller silent: finger disabled"),
                 FingerEvent::Enabled(f) => tracing::info!(finger = FINGER_NAMES[f], "finger controller back: finger enabled"),
@@ -756,6 +764,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             t_us: deadline,
             state: e.state(),
             faults: e.faults(),
+            window: e.window_problem(),
             counters: e.counters(),
             latency: e.latency().summary(),
             compute: e.compute().summary(),

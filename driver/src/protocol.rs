@@ -112,6 +112,10 @@ pub struct Status {
     pub state: String,
     /// Faults in force, comma separated, or "none".
     pub faults: String,
+    /// Why the EMG window cannot drive the fingers now (the reason of `invalid_window`), if it
+    /// cannot (absent from a daemon older than this field).
+    #[serde(default)]
+    pub window: Option<String>,
     /// Ticks since start.
     pub ticks: u64,
     /// Deadline misses since start.

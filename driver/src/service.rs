@@ -142,6 +142,7 @@ impl ControlHandler {
         Status {
             state: s.state.to_string(),
             faults: s.faults.to_string(),
+            window: s.window.map(|w| w.to_string()),
             ticks: s.counters.ticks,
             deadline_misses: s.counters.deadline_misses,
             samples_lost: s.counters.samples_lost,

@@ -4,7 +4,7 @@
 mod common;
 
 use common::Rig;
-use driver::engine::Command;
+use driver::engine::{Command, WindowProblem};
 use driver::safety::{DaemonState, Fault as DFault};
 use hand_dbc::messages::FingerMode;
 use hand_model::faults::{CrcTarget, Fault, FaultPlan};
@@ -58,6 +58,14 @@ fn amplifier_silence_stops_within_100ms_and_recovers_by_itself() {
         r.runner.engine().faults().contains(DFault::EmgSilence)
             || r.runner.engine().faults().contains(DFault::InvalidWindow)
     );
+    // The window's reason names the silence, 250 ms into it: the newest sample is that old
+    // (the stale rule, two ticks, goes before the silence in progress).
+    match r.runner.engine().window_problem() {
+        Some(WindowProblem::Stale { age_us }) => {
+            assert!((240_000..=260_000).contains(&age_us), "{age_us} us")
+        }
+        other => panic!("window problem {other:?} during the amplifier's silence"),
+    }
     // Signal back at +300 ms; the window refills (200 ms) and must stay good for 500 ms.
     r.run_until(ONSET + 300_000 + 600_000);
     assert_eq!(
@@ -71,6 +79,7 @@ fn amplifier_silence_stops_within_100ms_and_recovers_by_itself() {
         DaemonState::Running,
         "transient fault clears by itself"
     );
+    assert_eq!(r.runner.engine().window_problem(), None);
 }
 
 #[test]

@@ -74,6 +74,13 @@ fn format_model(s: &Status) -> String {
 /// The status as a table.
 pub fn format_status(s: &Status) -> String {
     let mut out = format_model(s);
+    // invalid_window with its reason, when this handd reports one.
+    let faults = match &s.window {
+        Some(w) if s.faults.split(',').any(|f| f == "invalid_window") => {
+            format!("{} (window: {w})", s.faults)
+        }
+        _ => s.faults.clone(),
+    };
     out += &format!(
         "state {}   faults {}\n\
          ticks {}   deadline misses {}   EMG samples lost {}   bad frames {}   windows beyond \
@@ -86,7 +93,7 @@ pub fn format_status(s: &Status) -> String {
          steps {}; receive queue drops (kernel) {}\n\n\
          {:<7} {:>7} {:>9} {:>11} {:>11} {:>7} {:>7}  {}\n",
         s.state,
-        s.faults,
+        faults,
         s.ticks,
         s.deadline_misses,
         s.samples_lost,
@@ -406,6 +413,21 @@ mod tests {
             "{text}"
         );
         assert!(!format_status(&Status::default()).contains("late ticks"));
+        // invalid_window with its reason; none for another fault.
+        let s = Status {
+            state: "SAFE".into(),
+            faults: "emg_silence,invalid_window".into(),
+            window: Some("no EMG frame for 34.0 ms".into()),
+            ..Status::default()
+        };
+        assert!(format_status(&s).contains(
+            "state SAFE   faults emg_silence,invalid_window (window: no EMG frame for 34.0 ms)\n"
+        ));
+        let s = Status {
+            faults: "estop".into(),
+            ..s
+        };
+        assert!(!format_status(&s).contains("window:"));
         let json = serde_json::to_value(Status::default()).unwrap();
         assert!(json.get("late_ticks").is_none());
     }

@@ -26,9 +26,11 @@ impl Engine {
         if self.emg.take_railed() >= RAIL_LIMIT || self.inputs.amp_reports_bad {
             self.fault(now_us, Fault::SignalQuality);
         }
-        let valid = self
+        let check = self
             .emg
-            .window_valid(now_us, self.settings.tick_us, self.settings.max_gap_us);
+            .window_check(now_us, self.settings.tick_us, self.settings.max_gap_us);
+        self.window_problem = check.err();
+        let valid = check.is_ok();
         if self.emg.chain.faults().any_in_window() {
             self.fault(now_us, Fault::NonFinite);
         } else if !valid

@@ -27,7 +27,7 @@ mod tx;
 
 pub use drives::{bank_settings, check_drives, MAX_IMMEDIATE};
 pub use epoch::{fresh_epoch, fresh_epochs};
-pub use rx::{amp_problem, AmpProblem, AMP_STATUS_SILENCE_US};
+pub use rx::{amp_problem, AmpProblem, WindowProblem, AMP_STATUS_SILENCE_US};
 pub use swap::{Hold, ModelSwap, SwapTicket};
 
 use decoder::dsp::ChainSettings;
@@ -164,6 +164,8 @@ pub struct Engine {
     drives: Option<drives::Drives>,
     epochs: epoch::Epochs,
     transitions: [Option<Transition>; 8],
+    /// Why the last tick's window was not valid, if it was not.
+    window_problem: Option<WindowProblem>,
     finger_events: [Option<FingerEvent>; N_FINGERS],
     /// Where every input goes when handd records a tape (`crate::tape`), and what it needs to
     /// say first: when the engine was built and its first epochs.
@@ -233,6 +235,7 @@ impl Engine {
                 .expect("the drive table was checked (check_drives) before the engine"),
             epochs: epoch::Epochs::new(epochs),
             transitions: [None; 8],
+            window_problem: None,
             finger_events: [None; N_FINGERS],
             settings,
             tape: None,
@@ -511,6 +514,11 @@ impl Engine {
         for e in self.finger_events.iter_mut().filter_map(Option::take) {
             on_finger(e);
         }
+    }
+
+    /// Why the last tick's window could not drive the fingers (None: it could).
+    pub fn window_problem(&self) -> Option<WindowProblem> {
+        self.window_problem
     }
 
     /// The daemon's state.

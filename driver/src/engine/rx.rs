@@ -137,20 +137,82 @@ impl EmgIn {
     }
 
     /// Whether the window ending at the newest sample may drive the fingers at `now_us`: full,
-    /// no gap inside, fresh, the stream still flowing, no bad sample in it.
-    pub(super) fn window_valid(&self, now_us: u64, tick_us: u64, max_gap_us: u64) -> bool {
+    /// no gap inside, fresh, the stream still flowing, no bad sample in it. Otherwise the
+    /// first rule it breaks, in that order.
+    pub(super) fn window_check(
+        &self,
+        now_us: u64,
+        tick_us: u64,
+        max_gap_us: u64,
+    ) -> Result<(), WindowProblem> {
         let window_len = self.chain.settings().window_len() as u64;
-        let full = self.chain.samples_seen() >= window_len;
-        let gap_left = self
+        if self.chain.samples_seen() < window_len {
+            return Err(WindowProblem::Filling);
+        }
+        if self
             .last_gap_at
-            .is_none_or(|at| self.samples_in - at >= window_len);
-        let fresh = self
+            .is_some_and(|at| self.samples_in - at < window_len)
+        {
+            return Err(WindowProblem::GapInWindow);
+        }
+        let age_us = self
             .newest_rx_us
-            .is_some_and(|t| now_us.saturating_sub(t) <= 2 * tick_us);
+            .map_or(u64::MAX, |t| now_us.saturating_sub(t));
+        if age_us > 2 * tick_us {
+            return Err(WindowProblem::Stale { age_us });
+        }
         // Silence longer than the gap limit is a gap in progress: the window will not be
         // complete, so stop now rather than wait for the silence timeout.
-        let flowing = now_us.saturating_sub(self.last_emg_us) <= max_gap_us;
-        full && gap_left && fresh && flowing && !self.chain.faults().any_in_window()
+        let silent_us = now_us.saturating_sub(self.last_emg_us);
+        if silent_us > max_gap_us {
+            return Err(WindowProblem::Silent { silent_us });
+        }
+        if self.chain.faults().any_in_window() {
+            return Err(WindowProblem::BadSample);
+        }
+        Ok(())
+    }
+}
+
+/// Why a window may not drive the fingers (the `invalid_window` fault's reason), for the log
+/// and `handctl status`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WindowProblem {
+    /// Fewer samples than the window since start or since the stream broke.
+    Filling,
+    /// The stream broke (samples lost, or a silence the counter cannot vouch for) within the
+    /// window.
+    GapInWindow,
+    /// The newest sample was received this long before the tick's deadline, µs.
+    Stale {
+        /// µs.
+        age_us: u64,
+    },
+    /// No EMG frame for this long before the tick's deadline, over the gap limit, µs.
+    Silent {
+        /// µs.
+        silent_us: u64,
+    },
+    /// A sample the chain could not use (non-finite) is in the window.
+    BadSample,
+}
+
+impl core::fmt::Display for WindowProblem {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Filling => f.write_str("the window is filling"),
+            Self::GapInWindow => f.write_str("the EMG stream broke within the window"),
+            Self::Stale { age_us } if *age_us == u64::MAX => f.write_str("no EMG sample yet"),
+            Self::Stale { age_us } => write!(
+                f,
+                "the newest EMG sample is {:.1} ms old",
+                *age_us as f64 * 1e-3
+            ),
+            Self::Silent { silent_us } => {
+                write!(f, "no EMG frame for {:.1} ms", *silent_us as f64 * 1e-3)
+            }
+            Self::BadSample => f.write_str("a non-finite sample in the window"),
+        }
     }
 }
 

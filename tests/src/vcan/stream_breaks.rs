@@ -125,6 +125,16 @@ pub fn unstepped(seen: &[Seen], step_us: i64) -> Vec<Seen> {
     out
 }
 
+/// handd's log lines of its state changes (each names the cause, and an invalid window's
+/// reason): what a stretch that is not excused is set against.
+pub fn state_changes(handd_log: &str) -> String {
+    handd_log
+        .lines()
+        .filter(|l| l.contains("state change"))
+        .map(|l| format!("  handd: {l}\n"))
+        .collect()
+}
+
 /// A stretch of setpoints that were not ACTIVE, and what the bus says of it.
 #[derive(Debug, Clone)]
 pub struct Stretch {

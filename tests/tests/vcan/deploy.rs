@@ -18,7 +18,7 @@ use driver::startup::fingerprint;
 use hand_dbc::messages::{FingerMode, HandHeartbeat};
 use handstack_tests::vcan::monitor::{now_us, Seen};
 use handstack_tests::vcan::setpoints_of;
-use handstack_tests::vcan::stream_breaks::{judge_not_active, stalled_within};
+use handstack_tests::vcan::stream_breaks::{judge_not_active, stalled_within, state_changes};
 
 use super::{wait_scenario_start, Rig};
 
@@ -190,7 +190,7 @@ fn deploy_refuses_bad_models_swaps_a_good_one_and_rolls_back() {
         to: rearmed + 1_500_000,
     };
     println!("deploy: during the refusals, the swap and the rollback: {judged}");
-    check(&seen, &times, (id_a, id_b));
+    check(&seen, &times, (id_a, id_b), &rig.handd.output());
     assert_eq!(judged.handd, 0, "a tick was missed: {judged}");
     assert_eq!(after.model.map(|m| m.id), Some(format!("{id_a:08x}")));
 }
@@ -227,7 +227,7 @@ struct Times {
 /// ModelId A until the deploy, B after it, A again after the rollback. The thumb's setpoints
 /// every tick throughout (no gap): ACTIVE before the deploy; from a tick after each swap only
 /// SAFE_STOP until its `arm`; ACTIVE again once the recovery time after the arm has passed.
-fn check(seen: &[Seen], t: &Times, (a, b): (u32, u32)) {
+fn check(seen: &[Seen], t: &Times, (a, b): (u32, u32), handd_log: &str) {
     let ids = heartbeat_ids(seen);
     assert!(ids
         .iter()
@@ -310,8 +310,9 @@ fn check(seen: &[Seen], t: &Times, (a, b): (u32, u32)) {
         assert!(
             all(&m, want),
             "{what}: want only {want:?}, got {m:?}; handd's HAND_HEARTBEAT in that span (ms from \
-             the refusals' start, state, faults), each change: {:?}",
-            daemon_states(seen, from, to, t.from)
+             the refusals' start, state, faults), each change: {:?}; handd's state changes:\n{}",
+            daemon_states(seen, from, to, t.from),
+            state_changes(handd_log)
         );
     }
     // Where the longest gap fell among the steps (a missed tick shows as one): ms from the
