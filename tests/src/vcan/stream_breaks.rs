@@ -12,13 +12,16 @@
 //!
 //! [`judge_not_active`] does: a stretch of setpoints that are not ACTIVE is **excused** only
 //! when all of these hold, and otherwise it stays a failure:
-//! - handd's HAND_HEARTBEAT in the stretch names only the EMG stream's faults (`invalid_window`,
-//!   `emg_silence`), and names one;
-//! - the monitor saw EMG_SAMPLES_G0 fall silent longer than the gap limit and at most
-//!   [`MAX_EXCUSED_SILENCE_US`] (a stall, not a fault injection or a clock step), and resume with
-//!   the next counter (no sample lost: the amplifier ran, its frames were late);
-//! - the stretch begins within [`ONSET_US`] after that silence ended, and ends within the
-//!   recovery time plus [`END_MARGIN_US`] after it.
+//! - handd's HAND_HEARTBEAT in the stretch says it is not RUNNING, and names only the EMG
+//!   stream's faults (`invalid_window`, `emg_silence`) or none (a fault that cleared within the
+//!   100 ms heartbeat period: only the recovery time shows);
+//! - the monitor saw the amplifier's frames (EMG_SAMPLES_G0..G2) fall silent longer than the
+//!   gap limit and at most [`MAX_EXCUSED_SILENCE_US`] (a stall, not a fault injection or a clock
+//!   step), and resume with the next counter (no sample lost: the amplifier ran, its frames
+//!   were late);
+//! - the stretch begins once that silence is over the gap limit (handsim alone stalled, handd
+//!   ran) and at most [`ONSET_US`] after it ended (the whole guest stood still), and ends
+//!   within the recovery time plus [`END_MARGIN_US`] after it.
 //!
 //! Every excuse is printed by the drill with its figures. Issue 29 asks for no bar to be
 //! widened silently: this is the change of the bar proposed in stop 40's note, made.
@@ -28,8 +31,8 @@ use hand_dbc::messages::{DaemonState, FingerMode, HandHeartbeat};
 use super::analysis::setpoints_of;
 use super::monitor::Seen;
 
-/// EMG_SAMPLES_G0's id; byte 1 is its sample counter.
-const EMG_G0_ID: u32 = 0x100;
+/// EMG_SAMPLES_G0..G2's ids; byte 1 is the sample counter.
+const EMG_IDS: [u32; 3] = [0x100, 0x101, 0x102];
 /// handd's gap limit (`hand_dbc::emg::DEFAULT_MAX_GAP_US`), µs.
 pub const GAP_LIMIT_US: u64 = hand_dbc::emg_front::DEFAULT_MAX_GAP_US;
 /// The longest silence that may excuse a stop, µs: longer than any stall seen (90.8 ms) and
@@ -65,27 +68,32 @@ impl EmgSilence {
     }
 }
 
-/// Every silence of EMG_SAMPLES_G0 longer than `min_us` the monitor saw.
+/// Every silence of the amplifier's frames (EMG_SAMPLES_G0..G2, any group) longer than
+/// `min_us` the monitor saw; in sequence when the frame that ends it carries the next counter
+/// of its group.
 pub fn emg_silences(seen: &[Seen], min_us: u64) -> Vec<EmgSilence> {
     let mut out = Vec::new();
-    let mut last: Option<(u64, u8)> = None;
+    let mut last_us: Option<u64> = None;
+    let mut last_counter: [Option<u8>; 3] = [None; 3];
     for s in seen {
-        let Some(f) = s.frame.as_ref().filter(|f| f.raw_id() == EMG_G0_ID) else {
+        let Some(f) = s.frame.as_ref().filter(|f| EMG_IDS.contains(&f.raw_id())) else {
             continue;
         };
         let Some(&counter) = f.data().get(1) else {
             continue;
         };
-        if let Some((t, c)) = last {
+        let group = (f.raw_id() - EMG_IDS[0]) as usize;
+        if let Some(t) = last_us {
             if s.time_us > t && s.time_us - t > min_us {
                 out.push(EmgSilence {
                     from_us: t,
                     to_us: s.time_us,
-                    in_sequence: counter == c.wrapping_add(1),
+                    in_sequence: last_counter[group] == Some(counter.wrapping_sub(1)),
                 });
             }
         }
-        last = Some((s.time_us, counter));
+        last_us = Some(s.time_us);
+        last_counter[group] = Some(counter);
     }
     out
 }
@@ -212,6 +220,7 @@ pub fn judge_not_active(seen: &[Seen], from_us: u64, to_us: u64, fingers: &[usiz
 
 fn judge(seen: &[Seen], silences: &[EmgSilence], (a, b): (u64, u64), onset_us: u64) -> Stretch {
     let mut names: Vec<&'static str> = Vec::new();
+    let mut stopped_beats = 0;
     for s in seen
         .iter()
         .filter(|s| s.time_us + 110_000 >= a && s.time_us <= b + 110_000)
@@ -227,6 +236,7 @@ fn judge(seen: &[Seen], silences: &[EmgSilence], (a, b): (u64, u64), onset_us: u
         if hb.state() == DaemonState::Running {
             continue;
         }
+        stopped_beats += 1;
         for f in driver::safety::Fault::ALL {
             if hb.fault_mask() & f.bit() != 0 && !names.contains(&f.name()) {
                 names.push(f.name());
@@ -236,23 +246,29 @@ fn judge(seen: &[Seen], silences: &[EmgSilence], (a, b): (u64, u64), onset_us: u
     let mut st = Stretch {
         from_us: a,
         to_us: b,
-        faults: names.join(","),
+        faults: if names.is_empty() && stopped_beats > 0 {
+            "none named: cleared within a heartbeat period, SAFE for the recovery time".into()
+        } else {
+            names.join(",")
+        },
         silence: None,
         why: String::new(),
     };
     let stream_only = |n: &&str| *n == "invalid_window" || *n == "emg_silence";
-    if names.is_empty() {
-        st.why = "no HAND_HEARTBEAT names a fault in it".into();
+    if stopped_beats == 0 {
+        st.why = "handd's HAND_HEARTBEAT says RUNNING throughout: not a stop of handd's".into();
     } else if !names.iter().all(stream_only) {
         st.why = "a fault other than the EMG stream's".into();
     } else {
+        // The stop may begin once the silence is over the gap limit (handd ran, the simulated
+        // amplifier did not) and up to `onset_us` after it ended (the whole guest stood still).
         let near = silences
             .iter()
-            .find(|s| s.to_us <= a + 5_000 && a <= s.to_us + onset_us);
+            .find(|s| s.from_us + GAP_LIMIT_US <= a + 5_000 && a <= s.to_us + onset_us);
         match near {
             None => {
                 st.why = format!(
-                    "no EMG silence over {} ms ended in the {} ms before it",
+                    "no EMG silence over {} ms before it (ended at most {} ms before it)",
                     GAP_LIMIT_US / 1000,
                     onset_us / 1000
                 )
@@ -371,7 +387,7 @@ mod tests {
         data[1] = counter;
         Seen {
             time_us: t,
-            frame: Some(CanFrame::new_standard(EMG_G0_ID as u16, &data).expect("frame")),
+            frame: Some(CanFrame::new_standard(EMG_IDS[0] as u16, &data).expect("frame")),
             read_us: t,
             socket: 0,
         }
@@ -389,8 +405,20 @@ mod tests {
     /// Two seconds of a hand: EMG every 1 ms but silent from 300 ms to `resume_ms` (resumed
     /// with `lost` samples skipped), every finger's setpoint every 50 ms (SAFE_STOP from
     /// `stop_ms` to `run_ms`), HAND_HEARTBEAT every 100 ms (Safe with `faults` while stopped).
-    fn hand(resume_ms: u64, lost: u8, (stop_ms, run_ms): (u64, u64), faults: u16) -> Vec<Seen> {
+    fn hand(resume_ms: u64, lost: u8, stop: (u64, u64), faults: u16) -> Vec<Seen> {
+        hand_with(resume_ms, lost, stop, faults, true)
+    }
+
+    /// [`hand`]; `whole_guest`: handd stood still with the amplifier (else it ran on).
+    fn hand_with(
+        resume_ms: u64,
+        lost: u8,
+        (stop_ms, run_ms): (u64, u64),
+        faults: u16,
+        whole_guest: bool,
+    ) -> Vec<Seen> {
         use hand_dbc::messages::{FingerSetpoint, HandHeartbeat};
+        let handd_runs = |ms: u64| !whole_guest || ms <= 300 || ms >= resume_ms;
         let mut seen = Vec::new();
         let mut counter = 0u8;
         for ms in 0..2_000u64 {
@@ -403,7 +431,7 @@ mod tests {
                 counter = counter.wrapping_add(1);
             }
             let stopped = ms >= stop_ms && ms < run_ms;
-            if ms % 50 == 0 && (ms <= 300 || ms >= resume_ms) {
+            if ms % 50 == 0 && handd_runs(ms) {
                 let mode = if stopped {
                     FingerMode::SafeStop
                 } else {
@@ -414,7 +442,7 @@ mod tests {
                     seen.push(frame(t + 500, FingerSetpoint::IDS[f], &sp.encode()));
                 }
             }
-            if ms % 100 == 0 && (ms <= 300 || ms >= resume_ms) {
+            if ms % 100 == 0 && handd_runs(ms) {
                 let (state, mask) = if stopped {
                     (DaemonState::Safe, faults)
                 } else {
@@ -465,6 +493,33 @@ mod tests {
         // A stop with no silence before it.
         let v = judge_not_active(&hand(301, 0, (600, 1_100), window), 0, 2_000_000, &[0]);
         assert!(v.unexcused().count() == 1, "{}", v.lines());
+        // handsim alone stalled: handd stops during the silence, once it is over the limit.
+        let v = judge_not_active(
+            &hand_with(360, 0, (325, 850), window, false),
+            0,
+            2_000_000,
+            &[0],
+        );
+        assert!(
+            v.stretches.len() == 1 && v.unexcused().count() == 0,
+            "{}",
+            v.lines()
+        );
+        // ... but not before the silence was over the limit.
+        let v = judge_not_active(
+            &hand_with(360, 0, (250, 750), window, false),
+            0,
+            2_000_000,
+            &[0],
+        );
+        assert!(v.unexcused().count() == 1, "{}", v.lines());
+        // A fault that cleared within a heartbeat period: SAFE with no fault named.
+        let v = judge_not_active(&hand(360, 0, (360, 900), 0), 0, 2_000_000, &[0]);
+        assert!(
+            v.stretches.len() == 1 && v.unexcused().count() == 0,
+            "{}",
+            v.lines()
+        );
         // The same from HAND_HEARTBEAT alone.
         let v = judge_not_running(&hand(360, 0, (360, 900), window), 0, 2_000_000);
         assert!(
