@@ -10,7 +10,9 @@
 //! beaten either.
 //!
 //! A late tick of handd's ([`LateTick`]: the deadline on CLOCK_MONOTONIC, the CPU it ran on) is
-//! charged to handd for the part of its lateness that no gap on its CPU covers; a tick whose
+//! charged to handd for the part of its lateness that no gap covers: while the loop still slept
+//! past its deadline a gap on any CPU (its timer's CPU is not known), after that a gap on the
+//! CPU it ran on; a tick whose
 //! uncovered lateness is beyond the slack is handd's miss. The meter never excuses a tick it
 //! did not see: more misses than the status keeps, or a meter without SCHED_FIFO, charge every
 //! miss to handd.
@@ -177,15 +179,31 @@ impl Stalls {
             .saturating_sub(self.covered_us(late, |_| true))
     }
 
-    /// The part of `late`'s lateness covered by the gaps on its CPU that `which` takes, µs.
+    /// The part of `late`'s lateness covered by the gaps that `which` takes, µs: while the
+    /// loop still slept past its deadline ([`LateTick::asleep_us`]) the gaps of whichever CPU
+    /// covers most (its expired timer waited on the CPU that armed it, which need not be the
+    /// one it then ran on: a tick woken 46.8 ms late on a CPU that ran nothing for 4.5 ms of
+    /// it, session 27), after that the gaps of the CPU it ran on.
     pub fn covered_us(&self, late: &LateTick, which: impl Fn(&Gap) -> bool) -> u64 {
-        let (from, to) = (
-            late.deadline_mono_us,
-            late.deadline_mono_us + late.lateness_us(),
-        );
+        let from = late.deadline_mono_us;
+        let woke = from + late.asleep_us.min(late.lateness_us());
+        let to = from + late.lateness_us();
+        let mut cpus: Vec<u32> = self.gaps.iter().map(|g| g.cpu).collect();
+        cpus.sort_unstable();
+        cpus.dedup();
+        let asleep = cpus
+            .iter()
+            .map(|&c| self.covered_on(c, from, woke, &which))
+            .max()
+            .unwrap_or(0);
+        asleep + self.covered_on(late.cpu, woke, to, &which)
+    }
+
+    /// Time in `[from, to)` that gaps on `cpu` taken by `which` cover, µs.
+    fn covered_on(&self, cpu: u32, from: u64, to: u64, which: &impl Fn(&Gap) -> bool) -> u64 {
         self.gaps
             .iter()
-            .filter(|g| g.cpu == late.cpu && which(g))
+            .filter(|g| g.cpu == cpu && which(g))
             .map(|g| to.min(g.to_us).saturating_sub(from.max(g.from_us)))
             .sum()
     }
@@ -266,7 +284,8 @@ impl std::fmt::Display for Judged {
                 f,
                 "\n  late tick at CLOCK_MONOTONIC {} us on CPU {}: {} us late (woke {} us, read \
                  {} us, {} frames; asleep past the deadline {} us, handd's loop ran {} us), {} \
-                 us of it while CPU {} ran nothing ({} us of that in gaps under {} us)",
+                 us of it while a CPU ran nothing (any CPU while the loop slept, then CPU {}; \
+                 {} us of that in gaps under {} us)",
                 t.deadline_mono_us,
                 t.cpu,
                 t.lateness_us(),
@@ -377,6 +396,31 @@ mod tests {
         // A gap that covers only 5 ms leaves 26 ms: handd's.
         let j = stalls(&[(1, 1_026_000, 1_040_000)]).judge(&before, &after, 25_000);
         assert_eq!(j.handd, 1, "{j}");
+    }
+
+    #[test]
+    fn while_the_loop_still_slept_a_gap_on_any_cpu_excuses_its_lateness() {
+        // 47 ms late on CPU 1, 46 ms of it still asleep: CPU 0 (where its timer may wait) ran
+        // nothing for 40 ms of that, CPU 1 for 4 ms. 47 - 40 = 7 ms: within the slack.
+        let t = LateTick {
+            asleep_us: 46_000,
+            ..late(1_000_000, 46_000, 1)
+        };
+        let gaps = [(0, 1_003_000, 1_043_000), (1, 1_010_000, 1_014_000)];
+        assert_eq!(stalls(&gaps).uncovered_us(&t), 7_000);
+        let after = status(4, vec![t]);
+        assert_eq!(
+            stalls(&gaps)
+                .judge(&status(3, vec![]), &after, 25_000)
+                .handd,
+            0
+        );
+        // Once awake (the read after the wake-up), only its own CPU's gaps count.
+        let t = LateTick {
+            asleep_us: 6_000,
+            ..late(1_000_000, 46_000, 1)
+        };
+        assert_eq!(stalls(&gaps).uncovered_us(&t), 47_000 - 3_000 - 4_000);
     }
 
     #[test]
