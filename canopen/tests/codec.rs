@@ -223,6 +223,52 @@ fn sdo_client_names_every_failure() {
 }
 
 #[test]
+fn a_late_reply_to_a_transfer_given_up_is_ignored_once_where_it_does_not_fit() {
+    // Session 27's fresh-clone run: a drive booted again while handd read 0x1018:01; handd
+    // cancelled and read 0x1018:01 again; the drive answered both requests, and the second
+    // answer arrived while handd read 0x1018:02 ("SDO reply for 0x1018:01, expected 0x1018:02").
+    let n = node(6);
+    let (vendor, product) = (ObjectAddr::new(0x1018, 1), ObjectAddr::new(0x1018, 2));
+    let reply = |addr, v| SdoReply::Uploaded(addr, SdoData::u32(v)).frame(n);
+    let mut c = SdoClient::new(n, 300_000);
+    c.upload(vendor, 0).expect("idle");
+    c.cancel();
+    assert!(!c.is_busy());
+    c.upload(vendor, 10).expect("idle after the cancel");
+    // The first request's answer fits the second (the same object): taken.
+    assert_eq!(
+        c.on_frame(&reply(vendor, 7)),
+        Some(Ok(SdoDone::Uploaded(SdoData::u32(7))))
+    );
+    c.upload(product, 20).expect("idle");
+    // The second request's answer, late: ignored, the transfer in flight goes on ...
+    assert_eq!(c.on_frame(&reply(vendor, 7)), None);
+    assert!(c.is_busy());
+    assert_eq!(
+        c.on_frame(&reply(product, 42)),
+        Some(Ok(SdoDone::Uploaded(SdoData::u32(42))))
+    );
+    // ... but only once: a wrong object after that is an error again.
+    c.upload(product, 30).expect("idle");
+    assert!(matches!(
+        c.on_frame(&reply(vendor, 7)),
+        Some(Err(SdoError::WrongObject { .. }))
+    ));
+    // After a timeout too, and never an object other than the one given up.
+    c.upload(vendor, 40).expect("idle");
+    assert!(c.poll(400_000).is_some());
+    c.upload(product, 400_010).expect("idle");
+    let other = ObjectAddr::new(0x6060, 0);
+    assert!(matches!(
+        c.on_frame(&reply(other, 1)),
+        Some(Err(SdoError::WrongObject { .. }))
+    ));
+    c.upload(product, 400_020).expect("idle");
+    assert_eq!(c.on_frame(&reply(vendor, 7)), None);
+    assert!(c.is_busy());
+}
+
+#[test]
 fn emcy_decodes_and_names_its_class() {
     let f = frame(0x08A, &[0x30, 0x81, 0x11, 1, 2, 3, 4, 5]);
     let e = Emcy::decode(&f).expect("EMCY");

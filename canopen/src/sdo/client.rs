@@ -89,6 +89,9 @@ pub struct SdoClient {
     node: NodeId,
     timeout_us: u64,
     pending: Option<Pending>,
+    /// The object of the last transfer given up (cancelled or timed out): its server may still
+    /// answer it, and that late reply belongs to no transfer in flight.
+    given_up: Option<ObjectAddr>,
 }
 
 impl SdoClient {
@@ -98,12 +101,17 @@ impl SdoClient {
             node,
             timeout_us,
             pending: None,
+            given_up: None,
         }
     }
 
-    /// Forgets the transfer in flight, if any: its server rebooted and will not answer it.
+    /// Forgets the transfer in flight, if any: its server rebooted. A reply to it that still
+    /// comes (sent before the reboot, or to a request the server had queued) is ignored once,
+    /// where it does not fit the transfer then in flight.
     pub fn cancel(&mut self) {
-        self.pending = None;
+        if let Some(p) = self.pending.take() {
+            self.given_up = Some(p.request.addr());
+        }
     }
 
     /// The server node.
@@ -145,33 +153,53 @@ impl SdoClient {
         Ok(request.frame(self.node))
     }
 
-    /// Offers a received frame. `None` if it is not this server's SDO reply or no transfer
-    /// is in progress; otherwise the transfer's end.
+    /// Offers a received frame. `None` if it is not this server's SDO reply, no transfer is in
+    /// progress, or it is the late reply to a transfer given up ([`SdoClient::cancel`], a
+    /// timeout) that does not fit the one in flight (ignored once; the transfer goes on);
+    /// otherwise the transfer's end.
     pub fn on_frame(&mut self, f: &CanFrame) -> Option<Result<SdoDone, SdoError>> {
         if f.cob_id() != 0x580 + u16::from(self.node.get()) {
             return None;
         }
         let p = self.pending.take()?;
+        let result = self.finish(p, f);
+        if let Some(late) = self.given_up {
+            let stale = match &result {
+                Err(SdoError::WrongObject { got, .. }) => *got == late,
+                Err(SdoError::Mismatch { addr, .. }) => *addr == late,
+                _ => false,
+            };
+            if stale {
+                self.given_up = None;
+                self.pending = Some(p);
+                return None;
+            }
+        }
+        Some(result)
+    }
+
+    /// The end of transfer `p` on reply `f` (this server's).
+    fn finish(&self, p: Pending, f: &CanFrame) -> Result<SdoDone, SdoError> {
         let node = self.node;
         let expected = p.request.addr();
         let reply = match SdoReply::decode(f, node) {
             Ok(r) => r,
             Err(error) => {
-                return Some(Err(SdoError::Malformed {
+                return Err(SdoError::Malformed {
                     node,
                     addr: expected,
                     error,
-                }))
+                })
             }
         };
         if reply.addr() != expected {
-            return Some(Err(SdoError::WrongObject {
+            return Err(SdoError::WrongObject {
                 node,
                 expected,
                 got: reply.addr(),
-            }));
+            });
         }
-        Some(match (p.request, reply) {
+        match (p.request, reply) {
             (_, SdoReply::Abort(addr, code)) => Err(SdoError::Aborted { node, addr, code }),
             (SdoRequest::Upload(_), SdoReply::Uploaded(_, d)) => Ok(SdoDone::Uploaded(d)),
             (SdoRequest::Download(..), SdoReply::Downloaded(_)) => Ok(SdoDone::Downloaded),
@@ -179,7 +207,7 @@ impl SdoClient {
                 node,
                 addr: expected,
             }),
-        })
+        }
     }
 
     /// Checks the deadline: on timeout, the error and the abort frame (0x0504_0000) to send.
@@ -190,6 +218,7 @@ impl SdoClient {
         }
         self.pending = None;
         let addr = p.request.addr();
+        self.given_up = Some(addr);
         let abort = SdoRequest::Abort(addr, AbortCode::Timeout).frame(self.node);
         Some((
             SdoError::Timeout {
