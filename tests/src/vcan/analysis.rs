@@ -1,7 +1,7 @@
 //! Reading what the monitor saw: the scenario's start, the setpoints and finger statuses, and
 //! when the daemon first commanded a safe stop.
 
-use hand_dbc::messages::{FingerMode, FingerSetpoint, FingerState, FingerStatus};
+use hand_dbc::messages::{FingerMode, FingerSetpoint, FingerState, FingerStatus, HandHeartbeat};
 
 use super::monitor::Seen;
 
@@ -111,4 +111,21 @@ pub fn first_safe_stop_after(
         latest = latest.max(t.time_us);
     }
     Some(latest)
+}
+
+/// The HAND_HEARTBEAT a seen frame carries, if it is one and decodes.
+pub fn heartbeat(s: &Seen) -> Option<HandHeartbeat> {
+    s.frame
+        .as_ref()
+        .filter(|f| f.raw_id() == HandHeartbeat::ID)
+        .and_then(|f| HandHeartbeat::decode(f.data()).ok())
+}
+
+/// The names of the faults in a HAND_HEARTBEAT's FaultMask, as `handctl status` names them.
+pub fn fault_names(mask: u16) -> Vec<&'static str> {
+    driver::safety::Fault::ALL
+        .iter()
+        .filter(|f| mask & f.bit() != 0)
+        .map(|f| f.name())
+        .collect()
 }

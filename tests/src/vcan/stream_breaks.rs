@@ -26,9 +26,9 @@
 //! Every excuse is printed by the drill with its figures. Issue 29 asks for no bar to be
 //! widened silently: this is the change of the bar proposed in stop 40's note, made.
 
-use hand_dbc::messages::{DaemonState, FingerMode, HandHeartbeat};
+use hand_dbc::messages::{DaemonState, FingerMode};
 
-use super::analysis::setpoints_of;
+use super::analysis::{fault_names, heartbeat, setpoints_of};
 use super::monitor::Seen;
 
 /// EMG_SAMPLES_G0..G2's ids; byte 1 is the sample counter.
@@ -225,21 +225,16 @@ fn judge(seen: &[Seen], silences: &[EmgSilence], (a, b): (u64, u64), onset_us: u
         .iter()
         .filter(|s| s.time_us + 110_000 >= a && s.time_us <= b + 110_000)
     {
-        let Some(hb) = s
-            .frame
-            .as_ref()
-            .filter(|f| f.raw_id() == HandHeartbeat::ID)
-            .and_then(|f| HandHeartbeat::decode(f.data()).ok())
-        else {
+        let Some(hb) = heartbeat(s) else {
             continue;
         };
         if hb.state() == DaemonState::Running {
             continue;
         }
         stopped_beats += 1;
-        for f in driver::safety::Fault::ALL {
-            if hb.fault_mask() & f.bit() != 0 && !names.contains(&f.name()) {
-                names.push(f.name());
+        for name in fault_names(hb.fault_mask()) {
+            if !names.contains(&name) {
+                names.push(name);
             }
         }
     }
@@ -298,12 +293,7 @@ pub fn judge_not_running(seen: &[Seen], from_us: u64, to_us: u64) -> Verdict {
     let mut stretches: Vec<(u64, u64)> = Vec::new();
     let mut running_since_last = true;
     for s in seen {
-        let Some(hb) = s
-            .frame
-            .as_ref()
-            .filter(|f| f.raw_id() == HandHeartbeat::ID)
-            .and_then(|f| HandHeartbeat::decode(f.data()).ok())
-        else {
+        let Some(hb) = heartbeat(s) else {
             continue;
         };
         if hb.state() == DaemonState::Running {

@@ -15,7 +15,8 @@ use std::time::Duration;
 
 use decoder::model::TrainedModel;
 use driver::startup::fingerprint;
-use hand_dbc::messages::{FingerMode, HandHeartbeat};
+use hand_dbc::messages::FingerMode;
+use handstack_tests::vcan::analysis::{fault_names, heartbeat};
 use handstack_tests::vcan::monitor::{now_us, Seen};
 use handstack_tests::vcan::setpoints_of;
 use handstack_tests::vcan::stream_breaks::{judge_not_active, stalled_within, state_changes};
@@ -86,11 +87,7 @@ fn model_files(model: &Path, dir: &Path) -> (String, String, String, u32) {
 /// HAND_HEARTBEAT's ModelId with its time.
 fn heartbeat_ids(seen: &[Seen]) -> Vec<(u64, u32)> {
     seen.iter()
-        .filter_map(|s| {
-            let f = s.frame.as_ref()?;
-            (f.raw_id() == HandHeartbeat::ID).then_some(())?;
-            Some((s.time_us, HandHeartbeat::decode(f.data()).ok()?.model_id()))
-        })
+        .filter_map(|s| Some((s.time_us, heartbeat(s)?.model_id())))
         .collect()
 }
 
@@ -99,19 +96,10 @@ fn heartbeat_ids(seen: &[Seen]) -> Vec<(u64, u32)> {
 fn daemon_states(seen: &[Seen], from: u64, to: u64, zero: u64) -> Vec<(i64, String, String)> {
     let mut out: Vec<(i64, String, String)> = Vec::new();
     for s in seen.iter().filter(|s| s.time_us >= from && s.time_us < to) {
-        let Some(hb) = s
-            .frame
-            .as_ref()
-            .filter(|f| f.raw_id() == HandHeartbeat::ID)
-            .and_then(|f| HandHeartbeat::decode(f.data()).ok())
-        else {
+        let Some(hb) = heartbeat(s) else {
             continue;
         };
-        let names: Vec<&str> = driver::safety::Fault::ALL
-            .iter()
-            .filter(|f| hb.fault_mask() & f.bit() != 0)
-            .map(|f| f.name())
-            .collect();
+        let names = fault_names(hb.fault_mask());
         let now = (format!("{:?}", hb.state()), names.join(","));
         if out.last().is_none_or(|l| (&l.1, &l.2) != (&now.0, &now.1)) {
             let ms = (s.time_us as i64 - zero as i64) / 1_000;
