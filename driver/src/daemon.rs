@@ -658,7 +658,19 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             self.bus_failed(t1, &e);
         }
         self.engine.written(t1, t1.saturating_sub(t0));
-        // Why an invalid window was invalid: named on the state change it causes.
+        self.log_events();
+        self.log_amp_problem();
+        self.publish(deadline);
+        if let Some(p) = &mut self.latches {
+            p.publish(self.engine.latches());
+        }
+        // A tick that ran past the next deadline: the next step skips what it missed.
+        self.next_deadline_us += self.tick_us;
+    }
+
+    /// Logs the engine's state changes and finger events of this tick; an invalid window's
+    /// reason is named on the state change it causes.
+    fn log_events(&mut self) {
         let window = self.engine.window_problem();
         self.engine.drain_events(
             |t| match (t.cause, window) {
@@ -670,13 +682,6 @@ impl<T: Transport, K: Clock> Runner<T, K> {
                 FingerEvent::Enabled(f) => tracing::info!(finger = FINGER_NAMES[f], "finger controller back: finger enabled"),
             },
         );
-        self.log_amp_problem();
-        self.publish(deadline);
-        if let Some(p) = &mut self.latches {
-            p.publish(self.engine.latches());
-        }
-        // A tick that ran past the next deadline: the next step skips what it missed.
-        self.next_deadline_us += self.tick_us;
     }
 
     /// Keeps where a late tick's time went (woken at `woke`, started at `started`, daemon

@@ -107,8 +107,15 @@ pub const STALL_MIN_US: u64 = 5_000;
 /// the time they took beyond the 1 ms the frames come at, µs. A bar on what handd does in
 /// that span counts the time the simulated world ran: this is what to take out of it.
 pub fn stalled_within(seen: &[Seen], from_us: u64, to_us: u64) -> (Vec<EmgSilence>, u64) {
-    let silences: Vec<EmgSilence> = emg_silences(seen, STALL_MIN_US)
-        .into_iter()
+    stalled_among(&emg_silences(seen, STALL_MIN_US), from_us, to_us)
+}
+
+/// [`stalled_within`] over silences found once (`emg_silences(seen, STALL_MIN_US)`), for a
+/// caller that asks about many spans of one bus.
+pub fn stalled_among(all: &[EmgSilence], from_us: u64, to_us: u64) -> (Vec<EmgSilence>, u64) {
+    let silences: Vec<EmgSilence> = all
+        .iter()
+        .copied()
         .filter(|s| s.in_sequence && s.from_us >= from_us && s.to_us <= to_us)
         .collect();
     let us = silences.iter().map(|s| s.len_us() - 1_000).sum();

@@ -19,7 +19,9 @@ use hand_dbc::messages::FingerMode;
 use handstack_tests::vcan::analysis::{fault_names, heartbeat};
 use handstack_tests::vcan::monitor::{now_us, Seen};
 use handstack_tests::vcan::setpoints_of;
-use handstack_tests::vcan::stream_breaks::{judge_not_active, stalled_within, state_changes};
+use handstack_tests::vcan::stream_breaks::{
+    emg_silences, judge_not_active, stalled_among, state_changes, STALL_MIN_US,
+};
 
 use super::{wait_scenario_start, Rig};
 
@@ -234,10 +236,11 @@ fn check(seen: &[Seen], t: &Times, (a, b): (u32, u32), handd_log: &str) {
         .collect();
     // Each gap as the simulated world saw it: a stall of the guest inside it (the amplifier's
     // frames silent, then in sequence: `stream_breaks`) is taken out, and printed below.
+    let silences = emg_silences(seen, STALL_MIN_US);
     let (gaps, gap_at, stalled) = thumb
         .windows(2)
         .map(|w| {
-            let (_, stalled) = stalled_within(seen, w[0].time_us, w[1].time_us);
+            let (_, stalled) = stalled_among(&silences, w[0].time_us, w[1].time_us);
             (w[1].time_us - w[0].time_us - stalled, w[0].time_us, stalled)
         })
         .max()
