@@ -160,7 +160,7 @@ pub struct Status {
 }
 
 /// Late ticks a status keeps.
-pub const LATE_TICKS_KEPT: usize = 8;
+pub const LATE_TICKS_KEPT: usize = 32;
 
 /// A tick that started later than the deadline slack, and where its time went: the loop
 /// waking up after the deadline (the scheduler, or a machine that did not run), then the bus

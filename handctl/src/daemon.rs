@@ -164,8 +164,14 @@ pub fn format_status(s: &Status) -> String {
         }
     }
     if !s.late_ticks.is_empty() {
+        // The status keeps up to LATE_TICKS_KEPT; the screen shows the newest few.
+        const SHOWN: usize = 8;
+        let older = s.late_ticks.len().saturating_sub(SHOWN);
         out += "\nlast late ticks (woke after the deadline + read the bus before starting)\n";
-        for l in &s.late_ticks {
+        if older > 0 {
+            out += &format!("  ({older} older ones kept: handctl status --json)\n");
+        }
+        for l in &s.late_ticks[older..] {
             out += &format!(
                 "  {:>6} us late = woke {:>6} us + read {:>5} us ({} frames), CPU {}, at \
                  CLOCK_MONOTONIC {:.3} s; asleep past the deadline {} us, the loop ran {} us\n",
@@ -413,6 +419,26 @@ mod tests {
             "{text}"
         );
         assert!(!format_status(&Status::default()).contains("late ticks"));
+        // Of many, the newest eight are shown, and where the rest are.
+        let tick = |i: u64| driver::protocol::LateTick {
+            deadline_mono_us: 1_000_000 * (i + 1),
+            wake_us: 26_000,
+            ..Default::default()
+        };
+        let many = Status {
+            late_ticks: (0..12).map(tick).collect(),
+            ..Status::default()
+        };
+        let text = format_status(&many);
+        assert!(
+            text.contains("(4 older ones kept: handctl status --json)"),
+            "{text}"
+        );
+        assert_eq!(text.matches(" us late = ").count(), 8, "{text}");
+        assert!(
+            !text.contains("CLOCK_MONOTONIC 4.000 s") && text.contains("CLOCK_MONOTONIC 5.000 s"),
+            "{text}"
+        );
         // invalid_window with its reason; none for another fault.
         let s = Status {
             state: "SAFE".into(),

@@ -28,6 +28,7 @@ use driver::service::{ControlHandler, COMMAND_QUEUE};
 use driver::socketcan_bus::SocketCanTransport;
 use driver::startup::{engine_settings, load_model, remove_stale_temps, LoadedModel};
 use hand_clock::{Clock, SystemClock};
+use tracing_appender::non_blocking::ErrorCounter;
 
 /// The handstack daemon.
 #[derive(Parser, Debug)]
@@ -86,7 +87,15 @@ fn loop_priority(priority: Option<u8>) {
 /// SCHED_FIFO priority of the kernel's threaded interrupt handlers.
 const IRQ_THREAD_PRIORITY: u8 = 50;
 
-fn init_logs(json: bool) {
+/// Log lines queued for the writer thread before further lines are dropped (and counted).
+const LOG_QUEUE_LINES: usize = 16_384;
+
+/// The log's writer: every thread formats its line and queues it; one thread of its own, at
+/// normal priority, writes the queue to stderr. The control loop (SCHED_FIFO) thus never waits
+/// on stderr: not on the process's stderr lock (a control-socket thread preempted while holding
+/// it would stall the loop behind it, a priority inversion), nor on a journal pipe that is full.
+/// A full queue drops the line rather than block; the count is printed at exit.
+fn init_logs(json: bool) -> (tracing_appender::non_blocking::WorkerGuard, ErrorCounter) {
     let filter = tracing_subscriber::EnvFilter::try_from_default_env()
         .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
     let colour = use_colour(
@@ -94,9 +103,15 @@ fn init_logs(json: bool) {
         std::io::stderr().is_terminal(),
         std::env::var_os("NO_COLOR").as_deref(),
     );
+    let (writer, guard) = tracing_appender::non_blocking::NonBlockingBuilder::default()
+        .buffered_lines_limit(LOG_QUEUE_LINES)
+        .lossy(true)
+        .thread_name("handd-log")
+        .finish(std::io::stderr());
+    let dropped = writer.error_counter();
     let builder = tracing_subscriber::fmt()
         .with_env_filter(filter)
-        .with_writer(std::io::stderr)
+        .with_writer(writer)
         .with_ansi(colour);
     // Under systemd the journal adds its own timestamps.
     let journald = std::env::var_os("JOURNAL_STREAM").is_some();
@@ -107,6 +122,7 @@ fn init_logs(json: bool) {
     } else {
         builder.init();
     }
+    (guard, dropped)
 }
 
 fn main() -> ExitCode {
@@ -114,8 +130,8 @@ fn main() -> ExitCode {
     if args.man {
         return print_man();
     }
-    init_logs(args.json_logs);
-    match run(&args) {
+    let (log_writer, dropped) = init_logs(args.json_logs);
+    let code = match run(&args) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             // Once, through the log: it reaches the terminal, the journal and a log collector
@@ -123,7 +139,16 @@ fn main() -> ExitCode {
             tracing::error!("refusing to start: {e}");
             ExitCode::from(2)
         }
+    };
+    // Every queued line written before handd ends.
+    drop(log_writer);
+    let lost = dropped.dropped_lines();
+    if lost > 0 {
+        eprintln!(
+            "handd: {lost} log lines were dropped: the log's queue was full (stderr too slow)"
+        );
     }
+    code
 }
 
 /// Prints the manual page generated from [`Args`] (clap_mangen).
