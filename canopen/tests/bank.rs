@@ -386,3 +386,75 @@ fn a_bank_that_cannot_work_is_refused() {
         Err(BankError::HeartbeatTimeout { .. })
     ));
 }
+
+#[test]
+fn nothing_left_in_a_drive_can_move_it_on_enable() {
+    use hand_canopen::startup::{
+        StartupSettings, ABORT_CONNECTION_QUICK_STOP, QUICK_STOP_RAMP_THEN_DISABLE,
+    };
+    for (mode, zeroed) in [
+        (Mode::CyclicSyncTorque, vec![0x6071]),
+        (Mode::CyclicSyncVelocity, vec![0x60FF, 0x6072]),
+        (Mode::ProfileVelocity, vec![0x60FF, 0x6072]),
+    ] {
+        let plan = StartupSettings {
+            node: node(5),
+            master: node(MASTER),
+            mode,
+            sync_period_us: TICK_US as u32,
+            sync_cob_id: CobId::try_new(SYNC).expect("11 bits"),
+            master_heartbeat_timeout_ms: 150,
+            drive_heartbeat_ms: 50,
+            abort_connection: ABORT_CONNECTION_QUICK_STOP,
+            quick_stop_option: QUICK_STOP_RAMP_THEN_DISABLE,
+            sdo_timeout_us: 20_000,
+            step_timeout_us: 200_000,
+        }
+        .plan()
+        .expect("a valid plan");
+        let start = plan
+            .iter()
+            .position(|s| matches!(s, Step::StartNode))
+            .expect("NMT start in the plan");
+        // Each object written 0 before the node starts, and read back as 0.
+        for index in &zeroed {
+            let zero_at = |s: &Step, write: bool| match s {
+                Step::ZeroTarget(w) if write => {
+                    w.addr == ObjectAddr::new(*index, 0) && w.data.as_u32() == 0
+                }
+                Step::ReadBack(w) if !write => {
+                    w.addr == ObjectAddr::new(*index, 0) && w.data.as_u32() == 0
+                }
+                _ => false,
+            };
+            assert!(
+                plan[..start].iter().any(|s| zero_at(s, true))
+                    && plan[..start].iter().any(|s| zero_at(s, false)),
+                "{mode:?}: 0x{index:04X} zeroed and read back before NMT start"
+            );
+        }
+        let all: Vec<u16> = plan
+            .iter()
+            .filter_map(|s| match s {
+                Step::ZeroTarget(w) => Some(w.addr.index),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(all, zeroed, "{mode:?}");
+    }
+    // And on the simulated drives: a velocity drive reaches Operation enabled with a zero
+    // torque limit (its dictionary's default is 1000 per mille), before any RPDO1 brings one.
+    let mut h = Hand::new();
+    let mut ticks = 0;
+    while h.drives[1].power_state() != PowerState::OperationEnabled {
+        assert!(ticks < 100, "drive 1 never enabled: {:?}", h.bank.status(1));
+        h.tick(&STOP);
+        ticks += 1;
+    }
+    assert!(
+        !h.sent.iter().any(|(_, f)| f.cob_id() == 0x206),
+        "an RPDO1 reached drive 1 before it was enabled"
+    );
+    assert_eq!(h.od(1, 0x6072, 0), 0);
+    assert_eq!(h.od(1, 0x60FF, 0), 0);
+}

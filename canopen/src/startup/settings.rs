@@ -134,19 +134,23 @@ impl StartupSettings {
         let pdos = finger_pdos(self.node, self.mode);
         config.extend(pdos.iter().flat_map(|p| p.plan()));
         read_back.extend(pdos.iter().flat_map(|p| p.expected()));
+        // Nothing left in the drive may move the motor on enable: the target, and in the
+        // velocity modes the torque limit too (until the first RPDO1 brings handd's, the drive
+        // would otherwise push with whatever limit its own memory holds).
         let zero = match self.mode {
-            Mode::CyclicSyncTorque => w(objects::TARGET_TORQUE, 0, SdoData::i16(0)),
-            Mode::CyclicSyncVelocity | Mode::ProfileVelocity => {
-                w(objects::TARGET_VELOCITY, 0, SdoData::i32(0))
-            }
+            Mode::CyclicSyncTorque => vec![w(objects::TARGET_TORQUE, 0, SdoData::i16(0))],
+            Mode::CyclicSyncVelocity | Mode::ProfileVelocity => vec![
+                w(objects::TARGET_VELOCITY, 0, SdoData::i32(0)),
+                w(objects::MAX_TORQUE, 0, SdoData::u16(0)),
+            ],
         };
-        read_back.push(zero);
+        read_back.extend(zero.iter().copied());
 
         let mut steps = vec![Step::ResetCommunication, Step::AwaitBootUp];
         steps.extend((1..=4).map(Step::ReadIdentity));
         steps.push(Step::CheckMode(self.mode));
         steps.extend(config.into_iter().map(Step::Write));
-        steps.push(Step::ZeroTarget(zero));
+        steps.extend(zero.into_iter().map(Step::ZeroTarget));
         steps.extend(read_back.into_iter().map(Step::ReadBack));
         steps.push(Step::StartNode);
         steps.push(Step::Enable);
