@@ -97,7 +97,8 @@ pub struct DaemonOpts {
     /// handd's control socket (default: the one in the config file).
     #[arg(long)]
     pub socket: Option<PathBuf>,
-    /// handd's config file, to find the socket (default /etc/handstack/handd.toml).
+    /// handd's config file, to find the socket (default /etc/handstack/handd.toml); `monitor
+    /// --iface/--log` also shows the CiA 402 drives it names.
     #[arg(long)]
     pub config: Option<PathBuf>,
 }

@@ -194,3 +194,93 @@ fn the_screen_from_a_log_shows_what_scipy_and_cantools_get_from_it() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `monitor --log --config`: the CiA 402 drives handd's config names, from their own frames
+/// in the log (heartbeat, TPDO1, EMCY); a `--config` that cannot be read is refused.
+#[test]
+fn the_drives_of_the_config_are_shown_from_their_frames_in_a_log() {
+    let dir = std::env::temp_dir().join(format!("handctl-monitor-drives-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch directory");
+    let drive = |finger: &str, node: u8| {
+        format!(
+            "[fingers.{finger}.drive]\nprofile = \"cia402\"\nnode_id = {node}\nmode = \"cst\"\n\
+             rated_torque_mnm = 25.0\ngear_ratio = 64.0\nmoment_arm_m = 0.04\n\
+             max_torque_permille = 1000\nmax_speed_rpm = 8000\n\n"
+        )
+    };
+    let config = dir.join("handd.toml");
+    std::fs::write(&config, drive("index", 6) + &drive("ring", 9)).expect("write the config");
+    // 2 s of frames every 50 ms: both drives beat (operational), the index reports Operation
+    // enabled in its TPDO1 (statusword 0x0637), the ring an EMCY at 1 s (0x2310: output
+    // current too high, continuous) and a statusword in Fault after it.
+    let mut log = String::new();
+    for k in 0..40u64 {
+        let t = 1_700_000_000.0 + k as f64 * 0.05;
+        log += &format!("({t:.6}) vcan0 706#05\n({t:.6}) vcan0 709#05\n");
+        log += &format!("({t:.6}) vcan0 186#3706000000000000\n");
+        if k == 20 {
+            log += &format!("({t:.6}) vcan0 089#1023010000000000\n");
+        }
+        let ring = if k >= 20 { "0800" } else { "3706" };
+        log += &format!("({t:.6}) vcan0 189#{ring}000000000000\n");
+    }
+    let path = dir.join("drives.log");
+    std::fs::write(&path, log).expect("write the log");
+    let out = Command::new(env!("CARGO_BIN_EXE_handctl"))
+        .args([
+            "monitor",
+            "--log",
+            path.to_str().unwrap(),
+            "--fast",
+            "--plain",
+        ])
+        .args(["--config", config.to_str().unwrap()])
+        .output()
+        .expect("run handctl monitor");
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let last = stdout
+        .lines()
+        .rfind(|l| l.contains("| drives "))
+        .unwrap_or_else(|| panic!("no line shows the drives: {stdout}"));
+    assert!(last.contains("index n6 Operation enabled"), "{last}");
+    assert!(last.contains("ring n9 STOPPED EMCY 0x2310"), "{last}");
+    // Without the config (and no default file here): no drive line.
+    if !std::path::Path::new(driver::config::DEFAULT_CONFIG_PATH).exists() {
+        let out = Command::new(env!("CARGO_BIN_EXE_handctl"))
+            .args([
+                "monitor",
+                "--log",
+                path.to_str().unwrap(),
+                "--fast",
+                "--plain",
+            ])
+            .output()
+            .expect("run handctl monitor");
+        assert!(out.status.success());
+        assert!(!String::from_utf8_lossy(&out.stdout).contains("| drives "));
+    }
+    // A --config that is not there is refused, naming it.
+    let missing = dir.join("missing.toml");
+    let out = Command::new(env!("CARGO_BIN_EXE_handctl"))
+        .args([
+            "monitor",
+            "--log",
+            path.to_str().unwrap(),
+            "--fast",
+            "--plain",
+        ])
+        .args(["--config", missing.to_str().unwrap()])
+        .output()
+        .expect("run handctl monitor");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && err.contains("missing.toml"),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -35,6 +35,11 @@ impl Monitor {
         }
     }
 
+    /// Follows these CiA 402 drives' frames too (the bus and log sources).
+    pub fn set_drives(&mut self, drives: super::drives::BusDrives) {
+        self.decoder.set_drives(drives);
+    }
+
     /// Takes one event.
     pub fn apply(&mut self, e: Event) {
         match e {

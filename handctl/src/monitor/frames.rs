@@ -14,7 +14,9 @@
 //!   as disabled);
 //! - FINGER_STATUS: reported position and force; a controller reporting DISABLED or FAULT, or
 //!   silent for 200 ms, shows its finger disabled;
-//! - EMG_STATUS: lead-off and saturation masks.
+//! - EMG_STATUS: lead-off and saturation masks;
+//! - each CiA 402 drive's heartbeat, TPDO1 and EMCY, when handd's config names the drives
+//!   ([`super::drives`]).
 //!
 //! E2E errors are those this monitor sees itself: EMG frames the front end drops for their CRC
 //! or length, and other protected frames whose CRC is wrong. The bus load is the worst-case bits
@@ -28,6 +30,7 @@ use hand_dbc::hand::N_FINGERS;
 use hand_dbc::messages::{self, FingerMode, FingerState, Message};
 use hand_dbc::CanFrame;
 
+use super::drives::BusDrives;
 use super::meters::{BusLoadMeter, LatencyWindow};
 use super::state::MonitorState;
 
@@ -51,6 +54,7 @@ pub struct FrameDecoder {
     crc_errors: u64,
     next_sample_us: Option<u64>,
     last_frame_us: Option<u64>,
+    drives: BusDrives,
 }
 
 impl FrameDecoder {
@@ -74,7 +78,14 @@ impl FrameDecoder {
             crc_errors: 0,
             next_sample_us: None,
             last_frame_us: None,
+            drives: BusDrives::default(),
         }
+    }
+
+    /// Follows these CiA 402 drives' frames too (handd's config says which node is which
+    /// finger).
+    pub fn set_drives(&mut self, drives: BusDrives) {
+        self.drives = drives;
     }
 
     /// Takes one frame received at `t_us`. Every 100 ms of frame time the state is refreshed
@@ -125,6 +136,9 @@ impl FrameDecoder {
         }
         d.e2e_errors = self.front.counters().e2e_errors + self.crc_errors;
         d.bus_load = self.load.load(t_us);
+        if !self.drives.is_empty() {
+            st.drives = self.drives.lines(t_us);
+        }
         st.update_noisy();
         st.sample_history();
     }
@@ -132,6 +146,9 @@ impl FrameDecoder {
     /// A non-EMG frame.
     fn on_message(&mut self, st: &mut MonitorState, frame: &CanFrame, t_us: u64) {
         let (id, data) = (frame.raw_id(), frame.data());
+        if self.drives.on_frame(id, data, t_us) {
+            return;
+        }
         if let Some(profile) = profile_of(id) {
             if data.is_empty() || profile.crc(data) != data[0] {
                 self.crc_errors += 1;

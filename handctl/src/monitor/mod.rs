@@ -3,7 +3,8 @@
 //!
 //! - [`state`]: what is shown ([`state::MonitorState`]), whatever the source;
 //! - [`live`]: the daemon's subscription lines into it; [`frames`]: bus or log frames into it
-//!   (the one EMG front end and the one signal chain), [`meters`]: bus load and latency;
+//!   (the one EMG front end and the one signal chain), [`drives`]: the CiA 402 drives' own
+//!   frames, [`meters`]: bus load and latency;
 //! - [`feed`]: one monitor fed by events; [`source`]: the three sources;
 //! - [`widgets`]: channel bars, finger table, daemon panel, plot: plain widgets over state,
 //!   for the guided calibration to reuse; [`screen`]: the layout and the text capture;
@@ -11,6 +12,7 @@
 //!   [`plain`]: one line per second; [`cpu`]: the monitor's own CPU use.
 
 pub mod cpu;
+pub mod drives;
 pub mod feed;
 pub mod frames;
 pub mod live;
@@ -30,6 +32,7 @@ use decoder::dsp::{ChainConfig, ChainSettings};
 use decoder::model::TrainedModel;
 
 use self::cpu::CpuMeter;
+use self::drives::BusDrives;
 use self::feed::{Event, Monitor};
 use self::plain::PlainPrinter;
 use self::view::View;
@@ -85,6 +88,27 @@ fn chain_and_rest(a: &MonitorArgs) -> Result<(ChainSettings, Option<Vec<f64>>), 
     Ok((settings, None))
 }
 
+/// The CiA 402 drives of handd's config, for the bus and log sources: `--config` (refused
+/// when it cannot be read or is not valid), or else the default file when there is one (a
+/// default file that cannot be used is said, and the bus shown without drives).
+fn bus_drives(a: &MonitorArgs) -> Result<BusDrives, CliError> {
+    let of = |path: &std::path::Path| {
+        let config = driver::config::Config::load(path)?;
+        Ok::<_, CliError>(BusDrives::of(&config.drives()?))
+    };
+    if let Some(path) = &a.daemon.config {
+        return of(path);
+    }
+    let path = std::path::Path::new(driver::config::DEFAULT_CONFIG_PATH);
+    if !path.exists() {
+        return Ok(BusDrives::default());
+    }
+    of(path).or_else(|e| {
+        eprintln!("handctl monitor: no CiA 402 drives shown: {e}");
+        Ok(BusDrives::default())
+    })
+}
+
 /// `handctl monitor`.
 pub fn run(a: &MonitorArgs) -> Result<(), CliError> {
     let (settings, rest) = chain_and_rest(a)?;
@@ -102,6 +126,9 @@ pub fn run(a: &MonitorArgs) -> Result<(), CliError> {
     let cpu = CpuMeter::start();
     let tui = !a.plain && a.screen.is_none() && std::io::stdout().is_terminal();
     let mut m = Monitor::new(source.title(), &settings);
+    if !matches!(source, Source::Daemon) {
+        m.set_drives(bus_drives(a)?);
+    }
     for (c, level) in m.state.channels.iter_mut().zip(rest.iter().flatten()) {
         c.rest_uv = Some(*level);
     }
