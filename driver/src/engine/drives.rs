@@ -47,13 +47,30 @@ pub(super) struct Drives {
     bank: DriveBank,
     /// Per finger: its slot in the bank and its scaling.
     slot: [Option<(usize, hand_canopen::scaling::Scaling)>; N_FINGERS],
-    /// Every drive's COB-IDs (for routing).
-    cob_ids: Vec<u16>,
+    /// Every drive's COB-IDs (for routing), one bit per 11-bit id: every received frame is
+    /// looked up, so a bit test rather than a scan of the 60 ids of five drives.
+    cob_ids: CobIdSet,
     targets: [Target; N_FINGERS],
     immediate: [CanFrame; MAX_IMMEDIATE],
     immediate_len: usize,
     /// Immediate frames dropped for want of room.
     pub(super) immediate_dropped: u64,
+}
+
+/// A set of 11-bit CAN ids.
+#[derive(Clone, Default)]
+struct CobIdSet([u64; 2048 / 64]);
+
+impl CobIdSet {
+    fn insert(&mut self, id: u16) {
+        let id = usize::from(id & 0x7FF);
+        self.0[id / 64] |= 1 << (id % 64);
+    }
+
+    fn contains(&self, id: u32) -> bool {
+        let id = id as usize;
+        id < 2048 && self.0[id / 64] & (1 << (id % 64)) != 0
+    }
 }
 
 fn to_dbc(f: hand_canopen::CanFrame) -> CanFrame {
@@ -69,7 +86,7 @@ impl Drives {
         };
         let mut list = Vec::new();
         let mut slot = [None; N_FINGERS];
-        let mut cob_ids = Vec::new();
+        let mut cob_ids = CobIdSet::default();
         for (f, d) in table.fingers.iter().enumerate() {
             if let Drive::Cia402 {
                 node,
@@ -79,7 +96,9 @@ impl Drives {
             {
                 slot[f] = Some((list.len(), scaling));
                 list.push((node, mode));
-                cob_ids.extend(CobId::all_of(node).iter().map(|c| c.raw()));
+                for c in CobId::all_of(node) {
+                    cob_ids.insert(c.raw());
+                }
             }
         }
         let bank = DriveBank::try_new(bank_settings(master, sync, tick_us), &list)
@@ -103,7 +122,7 @@ impl Drives {
 
     /// Whether `frame` is one of the drives' (handd routes it here, not to hand.dbc's decoder).
     pub(super) fn claims(&self, frame: &CanFrame) -> bool {
-        !frame.is_extended() && self.cob_ids.contains(&(frame.raw_id() as u16))
+        !frame.is_extended() && self.cob_ids.contains(frame.raw_id())
     }
 
     /// A drive's frame at `rx_us`; start-up replies wait in the immediate queue.
@@ -227,4 +246,22 @@ impl Drives {
 /// SYNC period must fit 0x60C2). handd and `--check` call it before building the engine.
 pub fn check_drives(table: &DriveTable, tick_us: u64) -> Result<(), String> {
     Drives::try_new(table, tick_us).map(|_| ())
+}
+
+#[cfg(test)]
+mod cob_id_set_tests {
+    use super::CobIdSet;
+
+    #[test]
+    fn holds_exactly_the_ids_put_in() {
+        let ids = [0x000, 0x07F, 0x085, 0x185, 0x705, 0x7FF];
+        let mut set = CobIdSet::default();
+        for id in ids {
+            set.insert(id);
+        }
+        for id in 0..4096u32 {
+            assert_eq!(set.contains(id), ids.contains(&(id as u16)), "id 0x{id:X}");
+        }
+        assert!(!set.contains(u32::MAX));
+    }
 }
