@@ -253,11 +253,11 @@ pub struct Runner<T: Transport, K: Clock> {
     late: [LateTick; LATE_TICKS_KEPT],
     late_count: u64,
     late_log: LogLimit,
-    /// When the loop's last sleep ended (daemon clock, µs) and the loop thread's CPU time then
-    /// (ns): where a late tick's time went ([`LateTick::asleep_us`], [`LateTick::ran_us`]).
-    /// Zero outside [`Runner::run_realtime`].
+    /// When the loop's last sleep ended (daemon clock, µs) and what the loop thread had used
+    /// then: where a late tick's time went ([`LateTick::asleep_us`], [`LateTick::ran_us`],
+    /// [`LateTick::waited`]). Zero outside [`Runner::run_realtime`].
     woke_us: u64,
-    woke_cpu_ns: u64,
+    woke_usage: crate::rt::ThreadUsage,
 }
 
 impl<T: Transport, K: Clock> Runner<T, K> {
@@ -297,7 +297,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             late: [LateTick::default(); LATE_TICKS_KEPT],
             late_count: 0,
             woke_us: 0,
-            woke_cpu_ns: 0,
+            woke_usage: crate::rt::ThreadUsage::default(),
             late_log: LogLimit::default(),
         }
     }
@@ -690,6 +690,11 @@ impl<T: Transport, K: Clock> Runner<T, K> {
     fn note_late(&mut self, deadline: u64, woke: u64, started: u64, frames: u64) {
         let since_deadline = self.clock.now_us().saturating_sub(deadline);
         let lateness = started.saturating_sub(deadline);
+        let used = if self.woke_us == 0 {
+            crate::rt::ThreadUsage::default()
+        } else {
+            crate::rt::ThreadUsage::now().since(self.woke_usage)
+        };
         let late = LateTick {
             deadline_mono_us: crate::rt::monotonic_us().saturating_sub(since_deadline),
             wake_us: woke.saturating_sub(deadline),
@@ -697,11 +702,9 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             frames,
             cpu: crate::rt::current_cpu(),
             asleep_us: self.woke_us.saturating_sub(deadline).min(lateness),
-            ran_us: if self.woke_us == 0 {
-                0
-            } else {
-                crate::rt::thread_cpu_ns().saturating_sub(self.woke_cpu_ns) / 1_000
-            },
+            ran_us: used.cpu_us,
+            waited: used.waited.min(u64::from(u32::MAX)) as u32,
+            preempted: used.preempted.min(u64::from(u32::MAX)) as u32,
         };
         self.late[(self.late_count % LATE_TICKS_KEPT as u64) as usize] = late;
         self.late_count += 1;
@@ -712,6 +715,8 @@ impl<T: Transport, K: Clock> Runner<T, K> {
                 read_us = late.read_us,
                 asleep_us = late.asleep_us,
                 ran_us = late.ran_us,
+                waited = late.waited,
+                preempted = late.preempted,
                 frames,
                 cpu = late.cpu,
                 left_out,
@@ -814,7 +819,7 @@ impl<T: Transport, K: Clock> Runner<T, K> {
             if wake > now {
                 std::thread::sleep(std::time::Duration::from_micros(wake - now));
                 self.woke_us = self.clock.now_us();
-                self.woke_cpu_ns = crate::rt::thread_cpu_ns();
+                self.woke_usage = crate::rt::ThreadUsage::now();
             }
             if self.clock.now_us() < self.next_deadline_us {
                 self.service_bus();

@@ -187,6 +187,14 @@ pub struct LateTick {
     /// after `asleep_us` is time the loop was awake but not running.
     #[serde(default)]
     pub ran_us: u64,
+    /// Times the loop gave up its CPU to wait from its last wake-up to the tick's start
+    /// (voluntary context switches: a lock, a page, the kernel): not zero when it was blocked.
+    #[serde(default)]
+    pub waited: u32,
+    /// Times another thread took its CPU in that time (involuntary context switches: a higher
+    /// priority, or the kernel's RT throttling).
+    #[serde(default)]
+    pub preempted: u32,
 }
 
 impl LateTick {

@@ -64,10 +64,42 @@ pub fn monotonic_us() -> u64 {
     t.tv_sec as u64 * 1_000_000 + t.tv_nsec as u64 / 1_000
 }
 
-/// The calling thread's CPU time, ns.
-pub fn thread_cpu_ns() -> u64 {
-    let t = rustix::time::clock_gettime(rustix::time::ClockId::ThreadCPUTime);
-    t.tv_sec as u64 * 1_000_000_000 + t.tv_nsec as u64
+/// What the calling thread used so far: its CPU time and its context switches.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ThreadUsage {
+    /// CPU time, user and system, µs.
+    pub cpu_us: u64,
+    /// Voluntary context switches (it waited).
+    pub waited: u64,
+    /// Involuntary context switches (another thread took its CPU).
+    pub preempted: u64,
+}
+
+impl ThreadUsage {
+    /// The calling thread's, now (one `getrusage(RUSAGE_THREAD)`; all zero if it fails).
+    pub fn now() -> Self {
+        use nix::sys::resource::{getrusage, UsageWho};
+        let Ok(u) = getrusage(UsageWho::RUSAGE_THREAD) else {
+            return Self::default();
+        };
+        let us = |t: nix::sys::time::TimeVal| {
+            (t.tv_sec().max(0) as u64) * 1_000_000 + t.tv_usec().max(0) as u64
+        };
+        Self {
+            cpu_us: us(u.user_time()) + us(u.system_time()),
+            waited: u.voluntary_context_switches().max(0) as u64,
+            preempted: u.involuntary_context_switches().max(0) as u64,
+        }
+    }
+
+    /// What was used from `earlier` to this.
+    pub fn since(self, earlier: Self) -> Self {
+        Self {
+            cpu_us: self.cpu_us.saturating_sub(earlier.cpu_us),
+            waited: self.waited.saturating_sub(earlier.waited),
+            preempted: self.preempted.saturating_sub(earlier.preempted),
+        }
+    }
 }
 
 /// The CPU the calling thread runs on.
@@ -78,6 +110,22 @@ pub fn current_cpu() -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn thread_usage_counts_a_wait_and_cpu_time() {
+        let before = ThreadUsage::now();
+        std::thread::sleep(std::time::Duration::from_millis(2));
+        let slept = ThreadUsage::now().since(before);
+        assert!(slept.waited >= 1, "a sleep is a voluntary switch: {slept:?}");
+        let start = std::time::Instant::now();
+        let mut x = 0u64;
+        while start.elapsed() < std::time::Duration::from_millis(20) {
+            x = std::hint::black_box(x.wrapping_add(1));
+        }
+        let spun = ThreadUsage::now().since(before);
+        assert!(spun.cpu_us >= 5_000, "20 ms of spinning is CPU time: {spun:?}");
+        assert_eq!(ThreadUsage::default().since(spun), ThreadUsage::default());
+    }
 
     #[test]
     fn set_up_reports_success_or_a_clear_warning() {

@@ -174,7 +174,8 @@ pub fn format_status(s: &Status) -> String {
         for l in &s.late_ticks[older..] {
             out += &format!(
                 "  {:>6} us late = woke {:>6} us + read {:>5} us ({} frames), CPU {}, at \
-                 CLOCK_MONOTONIC {:.3} s; asleep past the deadline {} us, the loop ran {} us\n",
+                 CLOCK_MONOTONIC {:.3} s; asleep past the deadline {} us, the loop ran {} us, \
+                 waited {}x, preempted {}x\n",
                 l.lateness_us(),
                 l.wake_us,
                 l.read_us,
@@ -182,7 +183,9 @@ pub fn format_status(s: &Status) -> String {
                 l.cpu,
                 l.deadline_mono_us as f64 / 1e6,
                 l.asleep_us,
-                l.ran_us
+                l.ran_us,
+                l.waited,
+                l.preempted
             );
         }
     }
@@ -406,6 +409,8 @@ mod tests {
                 cpu: 1,
                 asleep_us: 26_000,
                 ran_us: 900,
+                waited: 2,
+                preempted: 0,
             }],
             ..Status::default()
         };
@@ -414,7 +419,7 @@ mod tests {
             text.contains(
                 "\n   28500 us late = woke  27000 us + read  1500 us (96 frames), CPU 1, at \
                  CLOCK_MONOTONIC 224.400 s; asleep past the deadline 26000 us, the loop ran \
-                 900 us\n"
+                 900 us, waited 2x, preempted 0x\n"
             ),
             "{text}"
         );

@@ -283,7 +283,8 @@ impl std::fmt::Display for Judged {
             write!(
                 f,
                 "\n  late tick at CLOCK_MONOTONIC {} us on CPU {}: {} us late (woke {} us, read \
-                 {} us, {} frames; asleep past the deadline {} us, handd's loop ran {} us), {} \
+                 {} us, {} frames; asleep past the deadline {} us, handd's loop ran {} us, \
+                 waited {}x, preempted {}x), {} \
                  us of it while a CPU ran nothing (any CPU while the loop slept, then CPU {}; \
                  {} us of that in gaps under {} us)",
                 t.deadline_mono_us,
@@ -294,6 +295,8 @@ impl std::fmt::Display for Judged {
                 t.frames,
                 t.asleep_us,
                 t.ran_us,
+                t.waited,
+                t.preempted,
                 t.lateness_us() - uncovered,
                 t.cpu,
                 self.stalls
