@@ -116,14 +116,20 @@ mod tests {
         let before = ThreadUsage::now();
         std::thread::sleep(std::time::Duration::from_millis(2));
         let slept = ThreadUsage::now().since(before);
-        assert!(slept.waited >= 1, "a sleep is a voluntary switch: {slept:?}");
+        assert!(
+            slept.waited >= 1,
+            "a sleep is a voluntary switch: {slept:?}"
+        );
         let start = std::time::Instant::now();
         let mut x = 0u64;
         while start.elapsed() < std::time::Duration::from_millis(20) {
             x = std::hint::black_box(x.wrapping_add(1));
         }
         let spun = ThreadUsage::now().since(before);
-        assert!(spun.cpu_us >= 5_000, "20 ms of spinning is CPU time: {spun:?}");
+        assert!(
+            spun.cpu_us >= 5_000,
+            "20 ms of spinning is CPU time: {spun:?}"
+        );
         assert_eq!(ThreadUsage::default().since(spun), ThreadUsage::default());
     }
 

@@ -226,17 +226,22 @@ fn the_drives_of_the_config_are_shown_from_their_frames_in_a_log() {
     }
     let path = dir.join("drives.log");
     std::fs::write(&path, log).expect("write the log");
-    let out = Command::new(env!("CARGO_BIN_EXE_handctl"))
-        .args([
+    // `handctl monitor --log` of that log, plain, with `--config` when given.
+    let monitor = |config: Option<&std::path::Path>| {
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_handctl"));
+        cmd.args([
             "monitor",
             "--log",
             path.to_str().unwrap(),
             "--fast",
             "--plain",
-        ])
-        .args(["--config", config.to_str().unwrap()])
-        .output()
-        .expect("run handctl monitor");
+        ]);
+        if let Some(c) = config {
+            cmd.args(["--config", c.to_str().unwrap()]);
+        }
+        cmd.output().expect("run handctl monitor")
+    };
+    let out = monitor(Some(&config));
     let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
     assert!(
         out.status.success(),
@@ -251,32 +256,12 @@ fn the_drives_of_the_config_are_shown_from_their_frames_in_a_log() {
     assert!(last.contains("ring n9 STOPPED EMCY 0x2310"), "{last}");
     // Without the config (and no default file here): no drive line.
     if !std::path::Path::new(driver::config::DEFAULT_CONFIG_PATH).exists() {
-        let out = Command::new(env!("CARGO_BIN_EXE_handctl"))
-            .args([
-                "monitor",
-                "--log",
-                path.to_str().unwrap(),
-                "--fast",
-                "--plain",
-            ])
-            .output()
-            .expect("run handctl monitor");
+        let out = monitor(None);
         assert!(out.status.success());
         assert!(!String::from_utf8_lossy(&out.stdout).contains("| drives "));
     }
     // A --config that is not there is refused, naming it.
-    let missing = dir.join("missing.toml");
-    let out = Command::new(env!("CARGO_BIN_EXE_handctl"))
-        .args([
-            "monitor",
-            "--log",
-            path.to_str().unwrap(),
-            "--fast",
-            "--plain",
-        ])
-        .args(["--config", missing.to_str().unwrap()])
-        .output()
-        .expect("run handctl monitor");
+    let out = monitor(Some(&dir.join("missing.toml")));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         !out.status.success() && err.contains("missing.toml"),
