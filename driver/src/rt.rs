@@ -120,16 +120,20 @@ mod tests {
             slept.waited >= 1,
             "a sleep is a voluntary switch: {slept:?}"
         );
+        // Spin until 5 ms of CPU time show (on a loaded machine that takes longer than 5 ms
+        // of wall time); a usage that never grew would time out.
         let start = std::time::Instant::now();
         let mut x = 0u64;
-        while start.elapsed() < std::time::Duration::from_millis(20) {
-            x = std::hint::black_box(x.wrapping_add(1));
-        }
-        let spun = ThreadUsage::now().since(before);
-        assert!(
-            spun.cpu_us >= 5_000,
-            "20 ms of spinning is CPU time: {spun:?}"
-        );
+        let spun = loop {
+            for _ in 0..100_000 {
+                x = std::hint::black_box(x.wrapping_add(1));
+            }
+            let spun = ThreadUsage::now().since(before);
+            if spun.cpu_us >= 5_000 || start.elapsed() > std::time::Duration::from_secs(20) {
+                break spun;
+            }
+        };
+        assert!(spun.cpu_us >= 5_000, "spinning is CPU time: {spun:?}");
         assert_eq!(ThreadUsage::default().since(spun), ThreadUsage::default());
     }
 

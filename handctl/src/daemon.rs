@@ -163,31 +163,39 @@ pub fn format_status(s: &Status) -> String {
             }
         }
     }
-    if !s.late_ticks.is_empty() {
-        // The status keeps up to LATE_TICKS_KEPT; the screen shows the newest few.
-        const SHOWN: usize = 8;
-        let older = s.late_ticks.len().saturating_sub(SHOWN);
-        out += "\nlast late ticks (woke after the deadline + read the bus before starting)\n";
-        if older > 0 {
-            out += &format!("  ({older} older ones kept: handctl status --json)\n");
-        }
-        for l in &s.late_ticks[older..] {
-            out += &format!(
-                "  {:>6} us late = woke {:>6} us + read {:>5} us ({} frames), CPU {}, at \
-                 CLOCK_MONOTONIC {:.3} s; asleep past the deadline {} us, the loop ran {} us, \
-                 waited {}x, preempted {}x\n",
-                l.lateness_us(),
-                l.wake_us,
-                l.read_us,
-                l.frames,
-                l.cpu,
-                l.deadline_mono_us as f64 / 1e6,
-                l.asleep_us,
-                l.ran_us,
-                l.waited,
-                l.preempted
-            );
-        }
+    out += &late_ticks_section(&s.late_ticks);
+    out
+}
+
+/// The newest late ticks and where each one's time went (empty when none was late).
+fn late_ticks_section(late: &[driver::protocol::LateTick]) -> String {
+    let mut out = String::new();
+    if late.is_empty() {
+        return out;
+    }
+    // The status keeps up to LATE_TICKS_KEPT; the screen shows the newest few.
+    const SHOWN: usize = 8;
+    let older = late.len().saturating_sub(SHOWN);
+    out += "\nlast late ticks (woke after the deadline + read the bus before starting)\n";
+    if older > 0 {
+        out += &format!("  ({older} older ones kept: handctl status --json)\n");
+    }
+    for l in &late[older..] {
+        out += &format!(
+            "  {:>6} us late = woke {:>6} us + read {:>5} us ({} frames), CPU {}, at \
+             CLOCK_MONOTONIC {:.3} s; asleep past the deadline {} us, the loop ran {} us, \
+             waited {}x, preempted {}x\n",
+            l.lateness_us(),
+            l.wake_us,
+            l.read_us,
+            l.frames,
+            l.cpu,
+            l.deadline_mono_us as f64 / 1e6,
+            l.asleep_us,
+            l.ran_us,
+            l.waited,
+            l.preempted
+        );
     }
     out
 }

@@ -78,6 +78,28 @@ pub fn interpolation_period(period_us: u32) -> Option<(u8, i8)> {
 impl StartupSettings {
     /// Checks the settings and lays out the steps.
     pub fn plan(&self) -> Result<Vec<Step>, SettingsError> {
+        let (ip_value, ip_index) = self.validate()?;
+        let mut config = self.objects(ip_value, ip_index);
+        let mut read_back: Vec<SdoWrite> = config.clone();
+        let pdos = finger_pdos(self.node, self.mode);
+        config.extend(pdos.iter().flat_map(|p| p.plan()));
+        read_back.extend(pdos.iter().flat_map(|p| p.expected()));
+        let zero = self.zeroed();
+        read_back.extend(zero.iter().copied());
+
+        let mut steps = vec![Step::ResetCommunication, Step::AwaitBootUp];
+        steps.extend((1..=4).map(Step::ReadIdentity));
+        steps.push(Step::CheckMode(self.mode));
+        steps.extend(config.into_iter().map(Step::Write));
+        steps.extend(zero.into_iter().map(Step::ZeroTarget));
+        steps.extend(read_back.into_iter().map(Step::ReadBack));
+        steps.push(Step::StartNode);
+        steps.push(Step::Enable);
+        Ok(steps)
+    }
+
+    /// Refuses settings that cannot work; the 0x60C2 value and index of the SYNC period.
+    fn validate(&self) -> Result<(u8, i8), SettingsError> {
         if self.node == self.master {
             return Err(SettingsError::SameNode(self.node.get()));
         }
@@ -97,7 +119,7 @@ impl StartupSettings {
         if self.sync_cob_id == CobId::NMT || CobId::all_of(self.node).contains(&self.sync_cob_id) {
             return Err(SettingsError::SyncCobId(self.sync_cob_id.raw()));
         }
-        let (ip_value, ip_index) = interpolation_period(self.sync_period_us)
+        let period = interpolation_period(self.sync_period_us)
             .ok_or(SettingsError::SyncPeriod(self.sync_period_us))?;
         if u64::from(self.master_heartbeat_timeout_ms) * 1000 <= u64::from(self.sync_period_us) {
             return Err(SettingsError::WatchdogTooShort {
@@ -105,55 +127,53 @@ impl StartupSettings {
                 sync_us: self.sync_period_us,
             });
         }
-        let w = |index, sub, data| SdoWrite::new(ObjectAddr::new(index, sub), data);
+        Ok(period)
+    }
+
+    /// The communication and drive objects written (and read back), PDOs aside.
+    fn objects(&self, ip_value: u8, ip_index: i8) -> Vec<SdoWrite> {
         let consumer =
             (u32::from(self.master.get()) << 16) | u32::from(self.master_heartbeat_timeout_ms);
-        let mut config = vec![
-            w(0x1005, 0, SdoData::u32(u32::from(self.sync_cob_id.raw()))),
-            w(0x1017, 0, SdoData::u16(self.drive_heartbeat_ms)),
-            w(0x1016, 1, SdoData::u32(consumer)),
-            w(
+        vec![
+            write(0x1005, 0, SdoData::u32(u32::from(self.sync_cob_id.raw()))),
+            write(0x1017, 0, SdoData::u16(self.drive_heartbeat_ms)),
+            write(0x1016, 1, SdoData::u32(consumer)),
+            write(
                 objects::ABORT_CONNECTION,
                 0,
                 SdoData::i16(self.abort_connection),
             ),
-            w(
+            write(
                 objects::QUICK_STOP_OPTION,
                 0,
                 SdoData::i16(self.quick_stop_option),
             ),
-            w(objects::INTERPOLATION_PERIOD, 1, SdoData::u8(ip_value)),
-            w(objects::INTERPOLATION_PERIOD, 2, SdoData::i8(ip_index)),
-            w(
+            write(objects::INTERPOLATION_PERIOD, 1, SdoData::u8(ip_value)),
+            write(objects::INTERPOLATION_PERIOD, 2, SdoData::i8(ip_index)),
+            write(
                 objects::MODES_OF_OPERATION,
                 0,
                 SdoData::i8(self.mode.value()),
             ),
-        ];
-        let mut read_back: Vec<SdoWrite> = config.clone();
-        let pdos = finger_pdos(self.node, self.mode);
-        config.extend(pdos.iter().flat_map(|p| p.plan()));
-        read_back.extend(pdos.iter().flat_map(|p| p.expected()));
-        // Nothing left in the drive may move the motor on enable: the target, and in the
-        // velocity modes the torque limit too (until the first RPDO1 brings handd's, the drive
-        // would otherwise push with whatever limit its own memory holds).
-        let zero = match self.mode {
-            Mode::CyclicSyncTorque => vec![w(objects::TARGET_TORQUE, 0, SdoData::i16(0))],
-            Mode::CyclicSyncVelocity | Mode::ProfileVelocity => vec![
-                w(objects::TARGET_VELOCITY, 0, SdoData::i32(0)),
-                w(objects::MAX_TORQUE, 0, SdoData::u16(0)),
-            ],
-        };
-        read_back.extend(zero.iter().copied());
-
-        let mut steps = vec![Step::ResetCommunication, Step::AwaitBootUp];
-        steps.extend((1..=4).map(Step::ReadIdentity));
-        steps.push(Step::CheckMode(self.mode));
-        steps.extend(config.into_iter().map(Step::Write));
-        steps.extend(zero.into_iter().map(Step::ZeroTarget));
-        steps.extend(read_back.into_iter().map(Step::ReadBack));
-        steps.push(Step::StartNode);
-        steps.push(Step::Enable);
-        Ok(steps)
+        ]
     }
+
+    /// What is written 0 before the drive is enabled: nothing left in the drive may move the
+    /// motor on enable. The target, and in the velocity modes the torque limit too (until the
+    /// first RPDO1 brings handd's, the drive would otherwise push with whatever limit its own
+    /// memory holds).
+    fn zeroed(&self) -> Vec<SdoWrite> {
+        match self.mode {
+            Mode::CyclicSyncTorque => vec![write(objects::TARGET_TORQUE, 0, SdoData::i16(0))],
+            Mode::CyclicSyncVelocity | Mode::ProfileVelocity => vec![
+                write(objects::TARGET_VELOCITY, 0, SdoData::i32(0)),
+                write(objects::MAX_TORQUE, 0, SdoData::u16(0)),
+            ],
+        }
+    }
+}
+
+/// One expedited write of `data` to `index`:`sub`.
+fn write(index: u16, sub: u8, data: SdoData) -> SdoWrite {
+    SdoWrite::new(ObjectAddr::new(index, sub), data)
 }
