@@ -23,6 +23,12 @@ pub enum SimError {
     /// A node's bus handle could not be opened.
     #[error("cannot open the bus: {0}")]
     Transport(String),
+    /// The amplifier node's firmware refused the simulated board's settings.
+    #[error("the simulated amplifier board's settings: {0}")]
+    AmpBoardSettings(#[from] amp_node::NodeSettingsError),
+    /// The firmware's ADS1299 start-up failed on the simulated chips.
+    #[error("the simulated amplifier board's chips did not start: {0}")]
+    AmpBoardStart(#[from] ads1299::Error<embedded_hal::spi::ErrorKind>),
     /// An unknown scenario name.
     #[error("unknown scenario {0:?}; known: {1}")]
     UnknownScenario(String, String),

@@ -3,13 +3,15 @@
 
 mod common;
 
+use amp_node::BusScale;
 use common::Harness;
 use hand_dbc::e2e::{E2eChecker, E2eStatus};
 use hand_dbc::emg::{EmgAssembler, EmgConfig, EmgFrame, EMG_LSB_UV};
 use hand_dbc::messages::{EmgSamplesG0, EmgSamplesG1, EmgSamplesG2, EmgStatus};
-use hand_model::emg::{ChannelFaults, EmgSynth, ADC_MAX, ADC_MIN};
+use hand_model::emg::{quantise, ChannelFaults, EmgSynth, ADC_MAX, ADC_MIN};
 use hand_model::faults::{Fault, FaultPlan};
-use hand_model::nodes::{AmplifierNode, AmplifierNodeConfig};
+use hand_model::nodes::amp_board::BOARD_GAIN;
+use hand_model::nodes::{AmpBoard, AmplifierNode, AmplifierNodeConfig};
 use hand_model::patient::Intent;
 
 #[test]
@@ -49,14 +51,30 @@ fn hand_dbc_reassembles_the_synthesised_samples_bit_for_bit() {
     let (samples, asm) = reassemble(&h);
     assert_eq!(samples.len(), 1000);
     assert_eq!(asm.stats().lost_frames, 0);
-    // The same synthesiser, driven directly, gives the same counts.
+    // The same synthesiser, driven directly, through the chip's code and the firmware's
+    // scale gives the same counts; a direct rounding of the µV to the bus's LSB differs from
+    // that double rounding by at most one LSB, on few samples.
     let cfg = AmplifierNodeConfig::default();
     let mut synth = EmgSynth::try_new(cfg.signal.clone()).expect("valid");
     let act = cfg.drive.activation(&intent);
+    let scale = BusScale::new(BOARD_GAIN);
+    let mut uv = [0.0; 12];
+    let mut differ = 0;
     for (k, got) in samples.iter().enumerate() {
-        let want = synth.next_sample(&act, ChannelFaults::default()).counts;
+        synth.next_uv(&act, ChannelFaults::default(), &mut uv);
+        let want: [i16; 12] = std::array::from_fn(|c| scale.to_bus(AmpBoard::code(uv[c])).raw);
         assert_eq!(*got, want, "sample {k}");
+        let direct = quantise(&uv, EMG_LSB_UV).counts;
+        for (g, d) in got.iter().zip(direct) {
+            assert!((g - d).abs() <= 1, "sample {k}: {g} against {d}");
+            differ += usize::from(*g != d);
+        }
     }
+    println!("{differ} of 12,000 values one LSB off a direct rounding");
+    assert!(
+        differ < 12_000 / 20,
+        "{differ} values off a direct rounding"
+    );
     // Every frame passes its E2E check in sequence.
     for (id, profile) in [
         (EmgSamplesG0::ID, EmgSamplesG0::E2E),
@@ -75,7 +93,7 @@ fn hand_dbc_reassembles_the_synthesised_samples_bit_for_bit() {
             );
         }
     }
-    // EMG_STATUS at 10 Hz: at 0, 100, ..., 900 ms.
+    // EMG_STATUS at 10 Hz, after every 100th sample: at 99, 199, ..., 999 ms.
     assert_eq!(h.with_id(EmgStatus::ID).len(), 10);
 }
 
@@ -90,4 +108,46 @@ fn dropped_frames_are_counted_as_lost_by_the_reassembler() {
     // Frames 301..=600 are in the window (3 per sample from sample 100): every 7th of them.
     let dropped = (301..=600u64).filter(|n| n % 7 == 0).count() as u64;
     assert_eq!(asm.stats().lost_frames, dropped);
+}
+
+/// A stalled simulator (a poll 400 ms late) skips the backlog through the node core: the
+/// sample counter jumps over it, the statuses that fell due are sent, and each whose periods
+/// were missed says samples were dropped in the amplifier (Faults bit 4); nothing stale
+/// reaches the bus.
+#[test]
+fn a_stalled_simulator_skips_its_backlog_as_the_node_reports_it() {
+    let mut h = Harness::new();
+    let mut ep = h.bus.endpoint();
+    let mut amp = AmplifierNode::try_new(AmplifierNodeConfig::default()).expect("valid");
+    let mut polls = 0;
+    h.run(700_000, |t| {
+        // Polled every ms but from 200 to 600 ms, when the process stood still.
+        if !(200_000..600_000).contains(&t) {
+            polls += 1;
+            amp.poll(t, &mut ep);
+        }
+    });
+    assert!(polls > 0 && amp.samples_dropped() > 0);
+    let (samples, asm) = reassemble(&h);
+    let skipped = amp.samples_dropped();
+    assert_eq!(skipped, 400, "the samples due from 200 to 599 ms");
+    assert_eq!(amp.board().counters().missed, skipped);
+    assert_eq!(samples.len() as u64 + skipped, 701);
+    assert!(
+        asm.stats().lost_frames > 0 || asm.stats().gaps > 0,
+        "{:?}",
+        asm.stats()
+    );
+    let statuses: Vec<EmgStatus> = h
+        .with_id(EmgStatus::ID)
+        .into_iter()
+        .map(|(_, f)| EmgStatus::decode(f.data()).expect("valid"))
+        .collect();
+    assert_eq!(statuses.len(), 7, "every 100 periods, missed or not");
+    let flagged: Vec<bool> = statuses.iter().map(|s| s.faults() & 0x10 != 0).collect();
+    assert_eq!(
+        flagged,
+        [false, false, true, true, true, true, false],
+        "the statuses due at periods 300 to 600 cover the stall"
+    );
 }

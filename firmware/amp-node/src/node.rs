@@ -55,6 +55,8 @@ pub struct NodeCounters {
     pub spi_errors: u64,
     /// Periods without a sample: a status word without the 1100 header.
     pub bad_headers: u64,
+    /// Periods without a sample: conversions the node never read ([`AmpNode::on_missed`]).
+    pub missed: u64,
     /// Frames the CAN controller refused with an error (dropped).
     pub tx_errors: u64,
     /// Frames the controller handed back to make room for a higher-priority one (requeued).
@@ -234,6 +236,23 @@ impl<const Q: usize> AmpNode<Q> {
             self.saturation |= core::mem::take(&mut self.pair_saturation);
         }
         self.period_lost()
+    }
+
+    /// A bus period whose conversions the node never read: the firmware was held up past
+    /// the chips' next DRDY (a DRDY edge counter tells it how many). No frames; the counter
+    /// advances so the daemon's gap rule sees the loss, and the next EMG_STATUS reports it as
+    /// samples dropped in the amplifier (Faults bit 4), as a full transmit queue does. At
+    /// 2 kSPS the last conversion read stands in for the pair in the decimator's history.
+    pub fn on_missed(&mut self) {
+        self.counters.missed += 1;
+        if let Some(d) = &mut self.decimator {
+            let _ = d.push(&self.last);
+            let _ = d.push(&self.last);
+            self.pair_failed = false;
+            self.pair_saturation = 0;
+        }
+        self.faults |= FAULT_TX_OVERRUN;
+        self.end_period();
     }
 
     /// A bus period without a sample.

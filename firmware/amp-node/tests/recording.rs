@@ -10,17 +10,15 @@
 //! the 0.1 LSB margin that `count / 2.5` keeps from every rounding boundary, so the two
 //! roundings cannot disagree). Bus channel `c` carries 3DC channel `c % 10`.
 
-mod sim;
-
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use ads1299::{Ads1299, Code, Frame, Gain, LeadOff, Status};
+use ads1299_sim::SimAds1299;
 use amp_node::{AmpNode, NodeSettings, SampleOutcome, CHANNELS, STATUS_EVERY};
 use hand_dbc::emg_front::{EmgFront, EmgFrontConfig, EmgFrontSettings, FrontSample};
 use hand_dbc::messages::{AmpGain, AmpSampleRate, AmpState, EmgStatus};
 use hand_dbc::CanFrame;
-use sim::SimAds1299;
 
 const GAIN: Gain = Gain::X8;
 const SAMPLES: usize = 6_000;
@@ -113,7 +111,7 @@ fn node_frames_give_back_the_recording() {
         (&sim_a, settings.first_chip()),
         (&sim_b, settings.second_chip()),
     ] {
-        let st = sim.0.borrow();
+        let st = sim.state();
         assert!(st.regs[0x01..0x12] == s.block_a() && st.regs[0x14..0x18] == s.block_b());
         assert!(
             st.regs[0x17] & 0x02 != 0,
@@ -171,7 +169,7 @@ fn node_frames_give_back_the_recording() {
         } else {
             sim_b.serve(&fb);
         }
-        sim_a.0.borrow_mut().fail_next = i == SPI_ERROR;
+        sim_a.state().fail_next = i == SPI_ERROR;
         let outcome = node.sample(&mut chip_a, &mut chip_b);
         node.drain(&mut bus);
         let read = outcome != SampleOutcome::ReadError;

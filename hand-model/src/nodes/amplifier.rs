@@ -1,32 +1,33 @@
-//! The sEMG amplifier node: EMG_SAMPLES_G0..G2 at the sample rate, EMG_STATUS at 10 Hz.
+//! The sEMG amplifier node: the simulated patient's EMG through the firmware's own node core
+//! ([`AmpBoard`]: two simulated ADS1299 read by `amp-node`), which makes EMG_SAMPLES_G0..G2 at
+//! 1 kHz and EMG_STATUS every 100 samples; the bus faults of the plan act on its frames.
 
-use hand_dbc::messages::{
-    AmpGain, AmpSampleRate, AmpState, EmgSamplesG0, EmgSamplesG1, EmgSamplesG2, EmgStatus,
-};
+use hand_dbc::e2e::E2eProfile;
+use hand_dbc::messages::{EmgSamplesG0, EmgSamplesG1, EmgSamplesG2, EmgStatus};
 
-use super::{Bus, NodeStats};
+use super::{std_id, AmpBoard, Bus, NodeStats};
 use crate::dbc::{seal, CanFrame};
-use crate::emg::{AmplifierConfig, ChannelFaults, EmgSample, EmgSynth};
+use crate::emg::mixing::N_CHANNELS;
+use crate::emg::{AmplifierConfig, ChannelFaults, EmgSynth};
 use crate::error::SimError;
 use crate::faults::{CrcTarget, Fault, FaultPlan};
 use crate::patient::{Intent, MuscleDrive};
 
-/// EMG_STATUS fault bit 4: samples dropped in the amplifier (transmit overrun).
-pub const AMP_FAULT_TX_OVERRUN: u8 = 1 << 4;
+/// The bus's EMG sample rate, Hz: the firmware's node core puts 1 kHz on the bus.
+pub const NODE_RATE_HZ: f64 = 1000.0;
 
 /// Node-level settings around the signal model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AmplifierNodeConfig {
-    /// The signal model.
+    /// The signal model (its rate must be the node's, [`NODE_RATE_HZ`]).
     pub signal: AmplifierConfig,
     /// How intents drive the muscles.
     pub drive: MuscleDrive,
-    /// EMG_STATUS period, µs (hand.dbc: 100 ms).
-    pub status_period_us: u64,
     /// Time of the first sample, µs.
     pub start_us: u64,
     /// If a poll finds the node more than this far behind (a stalled process), the backlog is
-    /// dropped, counted and flagged in EMG_STATUS instead of being sent as one burst.
+    /// skipped: the node counts those periods missed, its counter jumps over them and its
+    /// next EMG_STATUS reports samples dropped, instead of a burst of stale samples.
     pub max_backlog_us: u64,
 }
 
@@ -35,7 +36,6 @@ impl Default for AmplifierNodeConfig {
         Self {
             signal: AmplifierConfig::default(),
             drive: MuscleDrive::default(),
-            status_period_us: 100_000,
             start_us: 0,
             max_backlog_us: 100_000,
         }
@@ -48,60 +48,50 @@ impl Default for AmplifierNodeConfig {
 pub struct AmplifierNode {
     cfg: AmplifierNodeConfig,
     synth: EmgSynth,
+    board: AmpBoard,
     intent: Intent,
     faults: FaultPlan,
     period_us: u64,
     next_sample_us: u64,
-    next_status_us: u64,
-    sample_counter: u8,
-    status_counter: u8,
+    /// Added to the node's sample counter on the bus (the counter-jump fault).
+    counter_jump: u8,
     emg_frames: u64,
     status_frames: u64,
-    saturation_since_status: u16,
-    overrun_since_status: bool,
     samples_dropped: u64,
     held_back: Option<[CanFrame; 3]>,
     one_shots: u64,
+    /// The board's frames of the current period (reused: no allocation per sample).
+    out: Vec<CanFrame>,
     stats: NodeStats,
 }
 
 impl AmplifierNode {
-    /// Builds the node; the sample rate must be one hand.dbc can announce (500, 1000 or 2000
-    /// Hz).
+    /// Builds the node; the signal's sample rate must be the node's ([`NODE_RATE_HZ`]).
     pub fn try_new(cfg: AmplifierNodeConfig) -> Result<Self, SimError> {
         cfg.drive.validate()?;
         let synth = EmgSynth::try_new(cfg.signal.clone())?;
-        if sample_rate_code(cfg.signal.sample_rate_hz).is_none() {
+        if cfg.signal.sample_rate_hz != NODE_RATE_HZ {
             return Err(SimError::OutOfRange {
                 name: "sample_rate_hz",
                 value: cfg.signal.sample_rate_hz,
-                allowed: "500, 1000 or 2000 Hz (hand.dbc EMG_STATUS SampleRate)",
-            });
-        }
-        if !(1_000..=10_000_000).contains(&cfg.status_period_us) {
-            return Err(SimError::OutOfRange {
-                name: "status_period_us",
-                value: cfg.status_period_us as f64,
-                allowed: "1 ms..=10 s",
+                allowed: "1000 Hz (the amplifier node's firmware puts 1 kHz on the bus)",
             });
         }
         let period_us = (1e6 / cfg.signal.sample_rate_hz).round() as u64;
         Ok(Self {
             next_sample_us: cfg.start_us,
-            next_status_us: cfg.start_us,
             synth,
+            board: AmpBoard::try_new()?,
             intent: Intent::REST,
             faults: FaultPlan::new(),
             period_us,
-            sample_counter: 0,
-            status_counter: 0,
+            counter_jump: 0,
             emg_frames: 0,
             status_frames: 0,
-            saturation_since_status: 0,
-            overrun_since_status: false,
             samples_dropped: 0,
             held_back: None,
             one_shots: 0,
+            out: Vec::with_capacity(8),
             stats: NodeStats::default(),
             cfg,
         })
@@ -142,7 +132,13 @@ impl AmplifierNode {
         &self.synth
     }
 
-    /// Generates and sends every sample and status due by `now_us`.
+    /// The firmware's node core on the simulated board.
+    pub fn board(&self) -> &AmpBoard {
+        &self.board
+    }
+
+    /// Generates and sends every sample (and the status the node makes every 100) due by
+    /// `now_us`.
     pub fn poll<B: Bus>(&mut self, now_us: u64, bus: &mut B) {
         // The amplifier listens to nothing; drain so a SocketCAN receive queue cannot fill.
         while self.stats.receive(bus).is_some() {}
@@ -150,18 +146,13 @@ impl AmplifierNode {
             let skipped = (now_us - self.next_sample_us) / self.period_us;
             self.samples_dropped += skipped;
             self.next_sample_us += skipped * self.period_us;
-            self.sample_counter = self.sample_counter.wrapping_add(skipped as u8);
-            self.overrun_since_status = true;
+            self.board.skip(skipped);
+            self.send_board_frames(self.next_sample_us, bus);
         }
         while self.next_sample_us <= now_us {
             let t = self.next_sample_us;
             self.send_sample(t, bus);
             self.next_sample_us += self.period_us;
-        }
-        while self.next_status_us <= now_us {
-            let t = self.next_status_us;
-            self.send_status(t, bus);
-            self.next_status_us += self.cfg.status_period_us;
         }
     }
 
@@ -182,23 +173,55 @@ impl AmplifierNode {
 
     fn send_sample<B: Bus>(&mut self, t: u64, bus: &mut B) {
         let act = self.cfg.drive.activation(&self.intent);
-        let sample = self.synth.next_sample(&act, self.channel_faults(t));
-        self.saturation_since_status |= sample.saturated;
-        let mut counter = self.sample_counter;
+        let cf = self.channel_faults(t);
+        let mut uv = [0.0; N_CHANNELS];
+        self.synth.next_uv(&act, cf, &mut uv);
+        self.board.convert(&uv, cf.lead_off);
         for (i, f) in self.faults.active(t) {
             if let Fault::CounterJump { by } = f {
                 if self.one_shots & (1 << i) == 0 {
                     self.one_shots |= 1 << i;
-                    counter = counter.wrapping_add(by);
+                    self.counter_jump = self.counter_jump.wrapping_add(by);
                 }
             }
         }
-        self.sample_counter = counter.wrapping_add(1);
-        let Some(mut frames) = emg_frames(&sample, counter) else {
-            // Unreachable while the quantiser clips to the DBC range; counted, never hidden.
-            self.stats.tx_errors += 3;
-            return;
-        };
+        self.send_board_frames(t, bus);
+    }
+
+    /// Sends what the node made this period, through the plan's bus faults: a sample's three
+    /// EMG frames (or none, if the node dropped it) and a status when one was due.
+    fn send_board_frames<B: Bus>(&mut self, t: u64, bus: &mut B) {
+        let mut out = std::mem::take(&mut self.out);
+        out.clear();
+        out.extend(self.board.take_frames());
+        let mut sample: [Option<CanFrame>; 3] = [None; 3];
+        for frame in &out {
+            match std_id(frame) {
+                EmgSamplesG0::ID => sample[0] = Some(*frame),
+                EmgSamplesG1::ID => sample[1] = Some(*frame),
+                EmgSamplesG2::ID => sample[2] = Some(*frame),
+                EmgStatus::ID => {}
+                _ => self.stats.tx_errors += 1,
+            }
+        }
+        if let [Some(g0), Some(g1), Some(g2)] = sample {
+            self.send_emg(t, [g0, g1, g2], bus);
+        }
+        // The node queues a status after the period's sample: in that order on the bus.
+        for frame in out.iter().filter(|f| std_id(f) == EmgStatus::ID) {
+            self.send_status(t, *frame, bus);
+        }
+        self.out = out;
+    }
+
+    /// One sample's EMG frames through the plan's faults.
+    fn send_emg<B: Bus>(&mut self, t: u64, mut frames: [CanFrame; 3], bus: &mut B) {
+        if self.counter_jump != 0 {
+            for (f, p) in frames.iter_mut().zip(EMG_PROFILES) {
+                let counter = f.data()[1] & counter_mask(p);
+                seal(f, p, counter.wrapping_add(self.counter_jump), false);
+            }
+        }
         let silent = self
             .faults
             .active(t)
@@ -265,14 +288,13 @@ impl AmplifierNode {
         }
     }
 
-    fn send_status<B: Bus>(&mut self, t: u64, bus: &mut B) {
-        let mut lead_off = 0u16;
+    /// The node's EMG_STATUS through the plan's faults (silence, a bad CRC).
+    fn send_status<B: Bus>(&mut self, t: u64, mut frame: CanFrame, bus: &mut B) {
         let mut silent = false;
         let mut bad_crc = false;
         self.status_frames += 1;
         for (_, f) in self.faults.active(t) {
             match f {
-                Fault::LeadOff { channels } => lead_off |= channels,
                 Fault::AmplifierSilence => silent = true,
                 Fault::BadCrc {
                     target: CrcTarget::EmgStatus,
@@ -281,64 +303,24 @@ impl AmplifierNode {
                 _ => {}
             }
         }
-        let faults = if self.overrun_since_status {
-            AMP_FAULT_TX_OVERRUN
-        } else {
-            0
-        };
-        let saturation = self.saturation_since_status;
-        self.saturation_since_status = 0;
-        self.overrun_since_status = false;
-        let counter = self.status_counter;
-        self.status_counter = (counter + 1) & 0x0F;
         if silent {
             return;
         }
-        let rate =
-            sample_rate_code(self.cfg.signal.sample_rate_hz).unwrap_or(AmpSampleRate::Sr1000Hz);
-        let state = if lead_off != 0 {
-            AmpState::Fault
-        } else {
-            AmpState::Running
-        };
-        let Ok(msg) = EmgStatus::new(state, rate, AmpGain::Gain1, lead_off, saturation, faults)
-        else {
-            self.stats.tx_errors += 1;
-            return;
-        };
-        let mut frame = msg.to_frame();
-        seal(&mut frame, EmgStatus::E2E, counter, bad_crc);
+        if bad_crc {
+            frame.data_mut()[0] ^= 0xFF;
+        }
         self.stats.transmit(bus, &frame);
     }
 }
 
-/// hand.dbc's code for a sample rate.
-fn sample_rate_code(hz: f64) -> Option<AmpSampleRate> {
-    match hz.round() as u32 {
-        500 => Some(AmpSampleRate::Sr500Hz),
-        1000 => Some(AmpSampleRate::Sr1000Hz),
-        2000 => Some(AmpSampleRate::Sr2000Hz),
-        _ => None,
-    }
-}
+/// The E2E profiles of EMG_SAMPLES_G0..G2, in the node's order.
+const EMG_PROFILES: [E2eProfile; 3] = [EmgSamplesG0::E2E, EmgSamplesG1::E2E, EmgSamplesG2::E2E];
 
-/// The three sealed EMG frames of one sample. `None` only if a count were outside the DBC's
-/// range, which the quantiser rules out.
-pub fn emg_frames(sample: &EmgSample, counter: u8) -> Option<[CanFrame; 3]> {
-    let uv = |c: usize| f64::from(sample.counts[c]) * EmgSamplesG0::EMG0_FACTOR;
-    let g0 = EmgSamplesG0::new(uv(0), uv(1), uv(2), uv(3))
-        .ok()?
-        .to_frame();
-    let g1 = EmgSamplesG1::new(uv(4), uv(5), uv(6), uv(7))
-        .ok()?
-        .to_frame();
-    let g2 = EmgSamplesG2::new(uv(8), uv(9), uv(10), uv(11))
-        .ok()?
-        .to_frame();
-    let mut frames = [g0, g1, g2];
-    let profiles = [EmgSamplesG0::E2E, EmgSamplesG1::E2E, EmgSamplesG2::E2E];
-    for (f, p) in frames.iter_mut().zip(profiles) {
-        seal(f, p, counter, false);
+/// The alive counter's bits in byte 1 under `profile`.
+fn counter_mask(profile: E2eProfile) -> u8 {
+    if profile.counter_bits() == 8 {
+        0xFF
+    } else {
+        0x0F
     }
-    Some(frames)
 }

@@ -3,6 +3,7 @@
 //! same node runs on a virtual clock over a [`crate::bus::MemBus`] in tests and in real time
 //! over SocketCAN in `handsim`.
 
+pub mod amp_board;
 pub mod amplifier;
 pub mod drive;
 pub mod epoch;
@@ -10,6 +11,7 @@ pub mod injector;
 pub mod motor;
 pub mod setpoints;
 
+pub use amp_board::AmpBoard;
 pub use amplifier::{AmplifierNode, AmplifierNodeConfig};
 pub use drive::{DriveFingerConfig, DriveFingerNode};
 pub use epoch::EpochGate;

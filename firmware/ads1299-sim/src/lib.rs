@@ -2,10 +2,13 @@
 //! command decoder (RESET, SDATAC, RDATAC, START, RREG, WREG) and a queue of data frames
 //! (codes) it serves in RDATAC mode. It also checks the serial timing the datasheet asks for:
 //! at least 4 tCLK between the bytes of a command.
+//!
+//! The amplifier node's host tests drive the firmware through it, and the simulator's
+//! amplifier (hand-model) serves its simulated patient's EMG through it to the firmware's own
+//! node core, so every in-memory and vcan test runs the node's code.
 
-use std::cell::RefCell;
 use std::collections::VecDeque;
-use std::rc::Rc;
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 
 use ads1299::registers::{channel_masks, config1, config2, config3, gpio};
 use ads1299::{command, Frame, FRAME_BYTES};
@@ -15,7 +18,7 @@ use embedded_hal::spi::{ErrorKind, ErrorType, Operation, SpiDevice};
 const FOUR_TCLK_NS: f64 = 4.0 * 1e9 / 2.048e6;
 
 /// The chip's state, shared between the test and the driver's handle.
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct SimState {
     /// Registers 00h..17h.
     pub regs: [u8; 0x18],
@@ -49,9 +52,16 @@ impl SimState {
     }
 }
 
-/// A handle to one simulated chip.
+/// A handle to one simulated chip (clones share the chip: one for the driver, one for the
+/// test or simulator that serves its conversions).
 #[derive(Debug, Clone)]
-pub struct SimAds1299(pub Rc<RefCell<SimState>>);
+pub struct SimAds1299(Arc<Mutex<SimState>>);
+
+impl Default for SimAds1299 {
+    fn default() -> Self {
+        Self::new()
+    }
+}
 
 impl SimAds1299 {
     /// A chip just powered (registers at reset, RDATAC).
@@ -66,7 +76,18 @@ impl SimAds1299 {
             ignored_commands: 0,
         };
         s.reset();
-        Self(Rc::new(RefCell::new(s)))
+        Self(Arc::new(Mutex::new(s)))
+    }
+
+    /// A chip in `state` (a copy of another's: see [`SimAds1299::state`]).
+    pub fn from_state(state: SimState) -> Self {
+        Self(Arc::new(Mutex::new(state)))
+    }
+
+    /// The chip's state, to read or script (a poisoned lock is taken as it is: the state is
+    /// plain data).
+    pub fn state(&self) -> MutexGuard<'_, SimState> {
+        self.0.lock().unwrap_or_else(PoisonError::into_inner)
     }
 
     /// A new conversion: the frame the next data read returns (replacing one never read).
@@ -76,7 +97,7 @@ impl SimAds1299 {
 
     /// A new conversion as raw bytes (a corrupted frame).
     pub fn serve_bytes(&self, bytes: [u8; FRAME_BYTES]) {
-        let mut s = self.0.borrow_mut();
+        let mut s = self.state();
         s.frames.clear();
         s.frames.push_back(bytes);
     }
@@ -95,7 +116,7 @@ impl ErrorType for SimAds1299 {
 
 impl SpiDevice for SimAds1299 {
     fn transaction(&mut self, ops: &mut [Operation<'_, u8>]) -> Result<(), ErrorKind> {
-        let mut s = self.0.borrow_mut();
+        let mut s = self.state();
         if s.fail_next {
             s.fail_next = false;
             return Err(ErrorKind::Other);
