@@ -3,12 +3,12 @@
 
 mod common;
 
-use amp_node::BusScale;
+use amp_node::{BusScale, DcBlock, DcRemoval};
 use common::Harness;
 use hand_dbc::e2e::{E2eChecker, E2eStatus};
 use hand_dbc::emg::{EmgAssembler, EmgConfig, EmgFrame, EMG_LSB_UV};
 use hand_dbc::messages::{EmgSamplesG0, EmgSamplesG1, EmgSamplesG2, EmgStatus};
-use hand_model::emg::{quantise, ChannelFaults, EmgSynth, ADC_MAX, ADC_MIN};
+use hand_model::emg::{ChannelFaults, EmgSynth, ADC_MAX, ADC_MIN};
 use hand_model::faults::{Fault, FaultPlan};
 use hand_model::nodes::amp_board::BOARD_GAIN;
 use hand_model::nodes::{AmpBoard, AmplifierNode, AmplifierNodeConfig};
@@ -51,29 +51,41 @@ fn hand_dbc_reassembles_the_synthesised_samples_bit_for_bit() {
     let (samples, asm) = reassemble(&h);
     assert_eq!(samples.len(), 1000);
     assert_eq!(asm.stats().lost_frames, 0);
-    // The same synthesiser, driven directly, through the chip's code and the firmware's
-    // scale gives the same counts; a direct rounding of the µV to the bus's LSB differs from
-    // that double rounding by at most one LSB, on few samples.
+    // The same synthesiser, driven directly, through the chip's code, the firmware's DC
+    // blocker and scale gives the same counts; the same DC blocker in f64 on the µV, rounded
+    // once to the bus's LSB, differs from them by at most one LSB, on few values.
     let cfg = AmplifierNodeConfig::default();
     let mut synth = EmgSynth::try_new(cfg.signal.clone()).expect("valid");
     let act = cfg.drive.activation(&intent);
     let scale = BusScale::new(BOARD_GAIN);
+    let DcRemoval::HighPass { shift } = DcRemoval::REFERENCE else {
+        panic!("the reference removes DC")
+    };
+    let mut block = DcBlock::<12>::new(shift);
+    let mut dc: Option<[f64; 12]> = None;
     let mut uv = [0.0; 12];
     let mut differ = 0;
     for (k, got) in samples.iter().enumerate() {
         synth.next_uv(&act, ChannelFaults::default(), &mut uv);
-        let want: [i16; 12] = std::array::from_fn(|c| scale.to_bus(AmpBoard::code(uv[c])).raw);
+        let codes = uv.map(AmpBoard::code);
+        let want = block.to_bus(&codes, scale).map(|v| v.raw);
         assert_eq!(*got, want, "sample {k}");
-        let direct = quantise(&uv, EMG_LSB_UV).counts;
-        for (g, d) in got.iter().zip(direct) {
-            assert!((g - d).abs() <= 1, "sample {k}: {g} against {d}");
-            differ += usize::from(*g != d);
+        let d = dc.get_or_insert(uv);
+        for c in 0..12 {
+            let float = ((uv[c] - d[c]) / EMG_LSB_UV).round() as i16;
+            d[c] += (uv[c] - d[c]) / f64::from(1u32 << shift);
+            assert!(
+                (got[c] - float).abs() <= 1,
+                "sample {k}: {} against {float}",
+                got[c]
+            );
+            differ += usize::from(got[c] != float);
         }
     }
-    println!("{differ} of 12,000 values one LSB off a direct rounding");
+    println!("{differ} of 12,000 values one LSB off the f64 reference");
     assert!(
         differ < 12_000 / 20,
-        "{differ} values off a direct rounding"
+        "{differ} values off the f64 reference"
     );
     // Every frame passes its E2E check in sequence.
     for (id, profile) in [

@@ -4,25 +4,25 @@
 //! training window ends) are equal bit for bit: the 96 features and the 5 model outputs of
 //! every window.
 //!
-//! Two recordings: (a) a real one, one 3DC armband recording (Power Grip, repetition 0, from
-//! `../shared/data/3dc-armband-p4`) quantized to the bus's LSB and written as EMG frames; (b) a
-//! simulated calibration (hand-model's quick protocol) recorded on the in-memory bus.
+//! Two recordings, both framed by the amplifier node's firmware core (`amp-node` over
+//! simulated ADS1299): (a) a real one, one 3DC armband recording (Power Grip, repetition 0,
+//! from `../shared/data/3dc-armband-p4`) served to the node, which quantizes it to the bus's
+//! LSB; (b) a simulated calibration (hand-model's quick protocol) recorded on the in-memory
+//! bus, whose amplifier is that node core.
 
 use std::path::{Path, PathBuf};
 
+use amp_node::DcRemoval;
 use decoder::dsp::npy::read_npy;
 use decoder::dsp::{ChainConfig, FEATURES_PER_CHANNEL};
 use decoder::model::{AnyModel, ModelKind, ModelSpec, Normalizer, TrainedModel, TrainingSummary};
 use decoder::session::{Session, SessionMeta, Trial, TrialKind, WindowOptions};
 use driver::engine::{Engine, EngineSettings};
 use hand_dbc::candump::{read_log, LogWriter};
-use hand_dbc::e2e::E2eProtector;
-use hand_dbc::emg::{EMG_CHANNELS, EMG_LSB_UV};
+use hand_dbc::emg::{EmgFrame, EMG_CHANNELS, EMG_LSB_UV};
 use hand_dbc::hand::{ADC_MAX, N_FINGERS};
-use hand_dbc::messages::{EmgSamplesG0, EmgSamplesG1, EmgSamplesG2};
-use hand_dbc::CanFrame;
 use hand_model::emg::AmplifierConfig;
-use hand_model::nodes::AmplifierNodeConfig;
+use hand_model::nodes::{AmpBoard, AmplifierNodeConfig};
 use hand_model::record::run_on_mem_bus;
 use hand_model::world::WorldConfig;
 use hand_model::Scenario;
@@ -55,17 +55,6 @@ fn model(chain: &ChainConfig) -> TrainedModel {
     TrainedModel::new(net, spec, norm, chain.clone(), summary).expect("model")
 }
 
-/// One sample's three EMG frames, E2E-protected; `raw` in bus LSB (12-bit range).
-fn sample_frames(p: &mut [E2eProtector; 3], raw: &[i16; EMG_CHANNELS]) -> [CanFrame; 3] {
-    let v = |c: usize| f64::from(raw[c]) * EMG_LSB_UV;
-    [
-        p[0].protect_message(&EmgSamplesG0::new(v(0), v(1), v(2), v(3)).expect("12 bit")),
-        p[1].protect_message(&EmgSamplesG1::new(v(4), v(5), v(6), v(7)).expect("12 bit")),
-        p[2].protect_message(&EmgSamplesG2::new(v(8), v(9), v(10), v(11)).expect("12 bit")),
-    ]
-    .map(|f| f.expect("right message"))
-}
-
 /// Samples `start..end` of the 3DC train recording of Power Grip, repetition 0, as raw counts
 /// (row-major, 10 channels).
 fn three_dc_power_grip() -> (Vec<f64>, usize) {
@@ -96,24 +85,41 @@ fn three_dc_power_grip() -> (Vec<f64>, usize) {
     (arr.data[a..b].to_vec(), channels)
 }
 
-/// (a) as a session directory: the 3DC samples, one count taken as 1 µV and quantized to
-/// the bus's 2.5 µV LSB (clipped to 12 bits), channel `c` of the bus carrying 3DC channel
-/// `c % 10`, one sample per ms, written as frames into `frames.log`, one rest trial over all.
+/// (a) as a session directory: the 3DC samples, one count taken as 1 µV, channel `c` of the
+/// bus carrying 3DC channel `c % 10`, one sample per ms, served to the amplifier node's
+/// firmware core over simulated ADS1299 (`AmpBoard`, as the simulator's amplifier), its
+/// frames (EMG and EMG_STATUS) written into `frames.log`, one rest trial over all. The node
+/// gives back every sample quantized to the bus's 2.5 µV LSB (clipped to 12 bits), checked
+/// here on the frames.
 fn write_three_dc_session(dir: &Path) {
     let (counts, channels) = three_dc_power_grip();
     let n = counts.len() / channels;
-    let mut p = [EmgSamplesG0::E2E, EmgSamplesG1::E2E, EmgSamplesG2::E2E].map(E2eProtector::new);
+    // DC-coupled, so the bus can be checked against the recording to the LSB (the simulated
+    // session (b) runs the reference board, DC removal on).
+    let mut board = AmpBoard::try_with(DcRemoval::Off).expect("the simulated amplifier board");
     let mut log = LogWriter::new(Vec::new());
     for i in 0..n {
-        let raw: [i16; EMG_CHANNELS] = std::array::from_fn(|c| {
-            let count = counts[i * channels + c % channels];
-            (count / EMG_LSB_UV).round().clamp(-2048.0, 2047.0) as i16
-        });
+        let uv: [f64; EMG_CHANNELS] = std::array::from_fn(|c| counts[i * channels + c % channels]);
+        board.convert(&uv, 0, 0);
         let t = T0_US + i as u64 * 1000;
-        for (g, f) in sample_frames(&mut p, &raw).iter().enumerate() {
-            log.write_frame(t + 100 * g as u64, "can0", f).expect("log");
+        for (g, f) in board.take_frames().enumerate() {
+            if let Ok(Some(frame)) = EmgFrame::decode(f.raw_id(), f.data()) {
+                for (k, raw) in frame.raw().iter().enumerate() {
+                    let c = 4 * usize::from(frame.group()) + k;
+                    let count = counts[i * channels + c % channels];
+                    let want = (count / EMG_LSB_UV).round().clamp(-2048.0, 2047.0) as i16;
+                    assert!(*raw == want, "sample {i}: {raw} on the bus, {want} wanted");
+                }
+            }
+            log.write_frame(t + 100 * g as u64, "can0", &f)
+                .expect("log");
         }
     }
+    assert!(
+        board.counters().queued == n as u64,
+        "{:?}",
+        board.counters()
+    );
     std::fs::write(dir.join("frames.log"), log.into_inner()).expect("write log");
     let rest = Trial {
         id: 1,

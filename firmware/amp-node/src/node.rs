@@ -10,7 +10,7 @@ use hand_dbc_core::messages::{AmpState, EmgSamplesG0, EmgSamplesG1, EmgSamplesG2
 use hand_dbc_core::CanFrame;
 
 use crate::decimator::ZERO;
-use crate::{BusScale, Decimator, NodeRate, NodeSettings, TxQueue};
+use crate::{BusScale, DcBlock, DcRemoval, Decimator, NodeRate, NodeSettings, TxQueue};
 
 /// EMG channels on the bus: the first chip's 8, then the second chip's channels 1..4.
 pub const CHANNELS: usize = 12;
@@ -88,6 +88,8 @@ pub struct AmpNode<const Q: usize = 12> {
     last: [Code; CHANNELS],
     pair_saturation: u16,
     pair_failed: bool,
+    /// The DC estimates, unless the settings send codes DC-coupled.
+    dc_block: Option<DcBlock<CHANNELS>>,
 }
 
 impl<const Q: usize> AmpNode<Q> {
@@ -116,6 +118,10 @@ impl<const Q: usize> AmpNode<Q> {
             last: [ZERO; CHANNELS],
             pair_saturation: 0,
             pair_failed: false,
+            dc_block: match settings.dc_removal() {
+                DcRemoval::Off => None,
+                DcRemoval::HighPass { shift } => Some(DcBlock::new(shift)),
+            },
         }
     }
 
@@ -195,9 +201,12 @@ impl<const Q: usize> AmpNode<Q> {
                 return self.period_lost();
             }
         }
+        let bus = match &mut self.dc_block {
+            Some(b) => b.to_bus(&codes, self.scale),
+            None => codes.map(|code| self.scale.to_bus(code)),
+        };
         let mut raw = [0i16; CHANNELS];
-        for (c, (r, code)) in raw.iter_mut().zip(codes).enumerate() {
-            let v = self.scale.to_bus(code);
+        for (c, (r, v)) in raw.iter_mut().zip(bus).enumerate() {
             *r = v.raw;
             if v.clipped {
                 self.saturation |= 1 << c;

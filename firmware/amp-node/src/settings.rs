@@ -17,6 +17,11 @@ pub enum NodeSettingsError {
     },
     /// A chip's settings were refused.
     Chip(ads1299::SettingsError),
+    /// [`DcRemoval::HighPass`] with a shift outside [`DcRemoval::SHIFTS`].
+    DcShift {
+        /// The refused shift.
+        shift: u8,
+    },
 }
 
 impl fmt::Display for NodeSettingsError {
@@ -27,11 +32,48 @@ impl fmt::Display for NodeSettingsError {
                 "gain {gain}: EMG_STATUS.Gain names powers of two only (1, 2, 4, 8 on the ADS1299)"
             ),
             Self::Chip(e) => write!(f, "chip settings: {e}"),
+            Self::DcShift { shift } => write!(
+                f,
+                "DC removal shift {shift}: {}..={} (corner {:.2}..{:.3} Hz at 1 kHz)",
+                DcRemoval::SHIFTS.start(),
+                DcRemoval::SHIFTS.end(),
+                DcRemoval::corner_hz(*DcRemoval::SHIFTS.start()),
+                DcRemoval::corner_hz(*DcRemoval::SHIFTS.end()),
+            ),
         }
     }
 }
 
 impl core::error::Error for NodeSettingsError {}
+
+/// Whether the node takes the electrodes' DC offset out before the bus ([`crate::DcBlock`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DcRemoval {
+    /// Codes go to the bus as they are (DC-coupled): only for a front end whose offsets are
+    /// known to stay far inside the bus's +-5.12 mV, and for tests that compare a recording
+    /// to the LSB.
+    Off,
+    /// A first-order DC blocker per channel at the bus's 1 kHz, pole `1 - 2^-shift`: the
+    /// corner near `1000 / (2π 2^shift)` Hz, an offset step decaying with `2^shift` ms.
+    HighPass {
+        /// 4..=12.
+        shift: u8,
+    },
+}
+
+impl DcRemoval {
+    /// The reference: shift 6, corner 2.5 Hz (the chain's 10 Hz band edge loses 2.2 %,
+    /// 0.2 dB; 20 Hz and up within 1 % of unity), a 30 mV step of an offset below one LSB within 0.7 s.
+    pub const REFERENCE: Self = Self::HighPass { shift: 6 };
+
+    /// The shifts accepted.
+    pub const SHIFTS: core::ops::RangeInclusive<u8> = 4..=12;
+
+    /// The -3 dB corner of `shift` at the bus's 1 kHz, Hz (first order).
+    pub fn corner_hz(shift: u8) -> f64 {
+        1000.0 / (core::f64::consts::TAU * f64::from(1u32 << shift))
+    }
+}
 
 /// How the node gets the bus's 1 kHz from the chips.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -62,6 +104,7 @@ impl NodeRate {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct NodeSettings {
     rate: NodeRate,
+    dc: DcRemoval,
     gain: Gain,
     amp_gain: AmpGain,
     first: Settings,
@@ -110,6 +153,7 @@ impl NodeSettings {
         let second = chip(inputs, BiasDrive::Off, ClockOutput::Off)?;
         Ok(Self {
             rate,
+            dc: DcRemoval::REFERENCE,
             gain,
             amp_gain,
             first,
@@ -117,9 +161,24 @@ impl NodeSettings {
         })
     }
 
+    /// These settings with `dc` (the reference's is [`DcRemoval::REFERENCE`]).
+    pub fn with_dc_removal(self, dc: DcRemoval) -> Result<Self, NodeSettingsError> {
+        if let DcRemoval::HighPass { shift } = dc {
+            if !DcRemoval::SHIFTS.contains(&shift) {
+                return Err(NodeSettingsError::DcShift { shift });
+            }
+        }
+        Ok(Self { dc, ..self })
+    }
+
     /// How the chips' conversions become the bus's 1 kHz.
     pub fn rate(&self) -> NodeRate {
         self.rate
+    }
+
+    /// Whether the DC goes before the bus.
+    pub fn dc_removal(&self) -> DcRemoval {
+        self.dc
     }
 
     /// The gain.

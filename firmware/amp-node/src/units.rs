@@ -67,12 +67,21 @@ impl BusScale {
                 clipped: true,
             };
         }
-        let num = i64::from(code.get()) * NUMERATOR;
-        let half = self.denominator / 2;
+        self.fraction_to_bus(i64::from(code.get()), 0)
+    }
+
+    /// A value in codes with `frac` fractional bits (`value / 2^frac` codes; |value| below
+    /// 2^41, `frac` at most 16: the product stays below 2^63) on the bus, rounded half away
+    /// from zero and clamped to the rails (flagged there), as [`BusScale::to_bus`].
+    #[inline]
+    pub fn fraction_to_bus(self, value: i64, frac: u32) -> BusSample {
+        let num = value * NUMERATOR;
+        let den = self.denominator << frac;
+        let half = den / 2;
         let q = if num >= 0 {
-            (num + half) / self.denominator
+            (num + half) / den
         } else {
-            (num - half) / self.denominator
+            (num - half) / den
         };
         let raw = q.clamp(i64::from(ADC_MIN), i64::from(ADC_MAX)) as i16;
         BusSample {

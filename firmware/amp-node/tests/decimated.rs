@@ -3,7 +3,7 @@
 //! costs that pair's sample and nothing else.
 
 use ads1299::{Code, Frame, Gain, LeadOff, Status};
-use amp_node::{AmpNode, BusScale, NodeRate, NodeSettings, SampleOutcome, TAPS};
+use amp_node::{AmpNode, BusScale, DcRemoval, NodeRate, NodeSettings, SampleOutcome, TAPS};
 use hand_dbc::CanFrame;
 use hand_dbc_core::emg::EmgFrame;
 
@@ -35,7 +35,10 @@ fn frame(v: i32) -> Frame {
 }
 
 fn settings(rate: NodeRate) -> NodeSettings {
-    NodeSettings::try_with_rate(rate, Gain::X8, LeadOff::Dc6nA).expect("settings")
+    // DC-coupled: these tests compare the bus with the chips' codes to the LSB.
+    NodeSettings::try_with_rate(rate, Gain::X8, LeadOff::Dc6nA)
+        .and_then(|s| s.with_dc_removal(DcRemoval::Off))
+        .expect("settings")
 }
 
 /// Group 0's (counter, channel 0) of every EMG frame sent.

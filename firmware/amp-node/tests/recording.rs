@@ -15,7 +15,7 @@ use std::path::PathBuf;
 
 use ads1299::{Ads1299, Code, Frame, Gain, LeadOff, Status};
 use ads1299_sim::SimAds1299;
-use amp_node::{AmpNode, NodeSettings, SampleOutcome, CHANNELS, STATUS_EVERY};
+use amp_node::{AmpNode, DcRemoval, NodeSettings, SampleOutcome, CHANNELS, STATUS_EVERY};
 use hand_dbc::emg_front::{EmgFront, EmgFrontConfig, EmgFrontSettings, FrontSample};
 use hand_dbc::messages::{AmpGain, AmpSampleRate, AmpState, EmgStatus};
 use hand_dbc::CanFrame;
@@ -101,7 +101,10 @@ fn node_frames_give_back_the_recording() {
         .expect("the recording has spikes beyond 5120 counts");
     let start = spike.saturating_sub(3_000).min(n_rec - SAMPLES);
 
-    let settings = NodeSettings::try_new(GAIN, LeadOff::Dc6nA).expect("settings");
+    // DC-coupled: the bus must give back the recording to the LSB.
+    let settings = NodeSettings::try_new(GAIN, LeadOff::Dc6nA)
+        .and_then(|s| s.with_dc_removal(DcRemoval::Off))
+        .expect("settings");
     let (sim_a, sim_b) = (SimAds1299::new(), SimAds1299::new());
     let mut chip_a = Ads1299::new(sim_a.clone());
     let mut chip_b = Ads1299::new(sim_b.clone());

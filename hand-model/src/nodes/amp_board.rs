@@ -5,13 +5,14 @@
 //!
 //! The patient's µV become the chips' 24-bit codes at the reference gain (x8: 67 nV per code,
 //! 37 times finer than the bus's 2.5 µV); the node reads them through the ADS1299 driver over
-//! a simulated SPI, scales them to the bus in its exact integer arithmetic, packs and protects
+//! a simulated SPI, takes out their DC (the reference's 2.5 Hz DC blocker), scales them to the
+//! bus in its exact integer arithmetic, packs and protects
 //! the frames (`hand-dbc-core`) and reports lead-off (from the chips' status words) and
 //! clipping in EMG_STATUS every 100 samples.
 
 use ads1299::{Ads1299, Code, Frame, Gain, LeadOff, Status};
 use ads1299_sim::SimAds1299;
-use amp_node::{AmpNode, BusScale, NodeCounters, NodeSettings, CHANNELS};
+use amp_node::{AmpNode, BusScale, DcRemoval, NodeCounters, NodeSettings, CHANNELS};
 
 use crate::dbc::CanFrame;
 use crate::error::SimError;
@@ -74,10 +75,17 @@ impl embedded_can::nb::Can for Controller {
 }
 
 impl AmpBoard {
-    /// Powers the chips and runs the firmware's start-up on them (reset, id check, registers
-    /// written and read back, RDATAC, START).
+    /// The reference board (the firmware's DC removal on): powers the chips and runs the
+    /// firmware's start-up on them (reset, id check, registers written and read back, RDATAC,
+    /// START).
     pub fn try_new() -> Result<Self, SimError> {
-        let settings = NodeSettings::try_new(BOARD_GAIN, LeadOff::Dc6nA)?;
+        Self::try_with(DcRemoval::REFERENCE)
+    }
+
+    /// [`AmpBoard::try_new`] with the node's DC removal as given (`Off`: the codes reach the
+    /// bus DC-coupled, to compare a recording with the bus to the LSB).
+    pub fn try_with(dc: DcRemoval) -> Result<Self, SimError> {
+        let settings = NodeSettings::try_new(BOARD_GAIN, LeadOff::Dc6nA)?.with_dc_removal(dc)?;
         let sims = (SimAds1299::new(), SimAds1299::new());
         let mut chips = (Ads1299::new(sims.0.clone()), Ads1299::new(sims.1.clone()));
         chips.0.init(settings.first_chip())?;
@@ -94,9 +102,17 @@ impl AmpBoard {
 
     /// One conversion: the 12 channels' µV (bus channel order) with the channels whose
     /// electrodes are off (`lead_off`, bit c = channel c; the chips' comparators report them on
-    /// the P side), read by the node; its frames are queued for [`AmpBoard::take_frames`].
-    pub fn convert(&mut self, uv: &[f64; CHANNELS], lead_off: u16) {
-        let code = |c: usize| Self::code(uv[c]);
+    /// the P side) and those whose ADC is driven into saturation (`saturated`: the chip's
+    /// positive full-scale code), read by the node; its frames are queued for
+    /// [`AmpBoard::take_frames`].
+    pub fn convert(&mut self, uv: &[f64; CHANNELS], lead_off: u16, saturated: u16) {
+        let code = |c: usize| {
+            if saturated & (1 << c) != 0 {
+                Code::POSITIVE_FULL_SCALE
+            } else {
+                Self::code(uv[c])
+            }
+        };
         let first = Frame {
             status: Status::new(lead_off as u8, 0, 0),
             codes: std::array::from_fn(code),

@@ -176,7 +176,7 @@ impl AmplifierNode {
         let cf = self.channel_faults(t);
         let mut uv = [0.0; N_CHANNELS];
         self.synth.next_uv(&act, cf, &mut uv);
-        self.board.convert(&uv, cf.lead_off);
+        self.board.convert(&uv, cf.lead_off, cf.saturated);
         for (i, f) in self.faults.active(t) {
             if let Fault::CounterJump { by } = f {
                 if self.one_shots & (1 << i) == 0 {
