@@ -40,6 +40,7 @@ use args::{Cli, Command};
 /// trained model reverses on a calibration ray and was not written, 5 a deploy to another
 /// patient was not confirmed).
 fn main() -> ExitCode {
+    quiet_on_a_closed_pipe();
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Train(a) => train::run(a),
@@ -87,4 +88,24 @@ fn run_demo(_: &args::DemoArgs) -> Result<(), error::CliError> {
         what: "the demo (it runs on the simulator, the `sim` feature)",
         build: DEMO_BUILD,
     })
+}
+
+/// `handctl status | head` and the like: when the reader of stdout goes away, Rust's runtime
+/// (which ignores SIGPIPE) makes `println!` (and the completion writer's `expect`) panic on
+/// EPIPE. Such a panic ends handctl quietly with the shell's code for a process killed by
+/// SIGPIPE (141), as a C tool ends; every other panic is reported as before.
+fn quiet_on_a_closed_pipe() {
+    let report = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let message = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if message.contains("Broken pipe") {
+            std::process::exit(141);
+        }
+        report(info);
+    }));
 }

@@ -616,6 +616,21 @@ fn completions_and_manual_pages_cover_every_subcommand() {
         let out = handctl(&["completions", shell]);
         assert!(out.status.success() && out.stdout.len() > 1000, "{shell}");
     }
+    // `handctl completions bash | head -0`: the reader gone before handctl writes ends it
+    // quietly with 141 (as SIGPIPE would), not with a panic's backtrace.
+    let (reader, writer) = std::io::pipe().expect("pipe");
+    drop(reader);
+    let closed = Command::new(env!("CARGO_BIN_EXE_handctl"))
+        .args(["completions", "bash"])
+        .stdout(writer)
+        .output()
+        .expect("run handctl");
+    assert!(
+        closed.status.code() == Some(141) && closed.stderr.is_empty(),
+        "{:?}: {}",
+        closed.status,
+        text(&closed.stderr)
+    );
     let bad = handctl(&["completions", "tcsh"]);
     assert_eq!(
         bad.status.code(),
