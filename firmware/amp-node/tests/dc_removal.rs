@@ -3,28 +3,13 @@
 //! the bus's +-5.12 mV, the sEMG on it intact.
 
 use ads1299::{Code, Frame, Gain, LeadOff, Status};
+use ads1299_sim::TakeAll;
 use amp_node::{
     AmpNode, BusScale, DcRemoval, NodeSettings, NodeSettingsError, SampleOutcome, CHANNELS,
 };
 use hand_dbc::emg::EmgFrame;
 use hand_dbc::messages::EmgStatus;
 use hand_dbc::CanFrame;
-
-struct Bus(Vec<CanFrame>);
-
-impl embedded_can::nb::Can for Bus {
-    type Frame = CanFrame;
-    type Error = embedded_can::ErrorKind;
-
-    fn transmit(&mut self, frame: &CanFrame) -> nb::Result<Option<CanFrame>, Self::Error> {
-        self.0.push(*frame);
-        Ok(None)
-    }
-
-    fn receive(&mut self) -> nb::Result<CanFrame, Self::Error> {
-        Err(nb::Error::WouldBlock)
-    }
-}
 
 /// Runs `ms` samples of a 200 µV, 80 Hz sine on every channel with a 40 mV offset from 100 ms
 /// on (it settles under one LSB in 0.62 s with the reference's shift 6); returns the
@@ -36,7 +21,7 @@ fn run(dc: DcRemoval, ms: usize) -> ([i16; CHANNELS], Vec<u16>) {
         .expect("settings");
     let per_code = BusScale::new(Gain::X8).uv_per_code();
     let mut node: AmpNode = AmpNode::new(&settings);
-    let mut bus = Bus(Vec::new());
+    let mut bus: TakeAll<CanFrame> = TakeAll::default();
     let mut largest = [0i16; CHANNELS];
     let mut masks = Vec::new();
     for n in 0..ms {

@@ -11,7 +11,7 @@
 //! clipping in EMG_STATUS every 100 samples.
 
 use ads1299::{Ads1299, Code, Frame, Gain, LeadOff, Status};
-use ads1299_sim::SimAds1299;
+use ads1299_sim::{SimAds1299, TakeAll};
 use amp_node::{AmpNode, BusScale, DcRemoval, NodeCounters, NodeSettings, CHANNELS};
 
 use crate::dbc::CanFrame;
@@ -35,7 +35,7 @@ pub struct AmpBoard {
     /// The test side of the chips: where their conversions are served.
     sims: (SimAds1299, SimAds1299),
     /// What the node handed to its CAN controller since the last [`AmpBoard::take_frames`].
-    out: Controller,
+    out: TakeAll<CanFrame>,
 }
 
 impl Clone for AmpBoard {
@@ -52,25 +52,6 @@ impl Clone for AmpBoard {
             sims,
             out: self.out.clone(),
         }
-    }
-}
-
-/// The node's CAN controller: takes every frame (the simulator's own bus, with its faults,
-/// comes after it).
-#[derive(Debug, Clone, Default)]
-struct Controller(Vec<CanFrame>);
-
-impl embedded_can::nb::Can for Controller {
-    type Frame = CanFrame;
-    type Error = embedded_can::ErrorKind;
-
-    fn transmit(&mut self, frame: &CanFrame) -> nb::Result<Option<CanFrame>, Self::Error> {
-        self.0.push(*frame);
-        Ok(None)
-    }
-
-    fn receive(&mut self) -> nb::Result<CanFrame, Self::Error> {
-        Err(nb::Error::WouldBlock)
     }
 }
 
@@ -96,7 +77,7 @@ impl AmpBoard {
             node: AmpNode::new(&settings),
             chips,
             sims,
-            out: Controller::default(),
+            out: TakeAll::default(),
         })
     }
 
