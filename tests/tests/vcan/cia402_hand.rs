@@ -12,7 +12,7 @@ use hand_model::nodes::DriveFingerConfig;
 use hand_model::patient::{Target, TrackingConfig};
 use handstack_tests::vcan::monitor::now_us;
 use handstack_tests::vcan::procs::handsim;
-use handstack_tests::vcan::stream_breaks::judge_not_running;
+use handstack_tests::vcan::stream_breaks::{emg_silences, judge_not_running};
 use handstack_tests::vcan::{scenario_start_us, Monitor, TestConfig, VcanEnv};
 
 use super::calibrated_model;
@@ -156,10 +156,26 @@ fn j_every_finger_on_a_drive_tracks_one_trips_alone_and_all_stop_on_their_watchd
                 .map(|e| (f, e.0 - start))
         })
         .collect();
+    // Whether the simulated world (handsim, in the same guest) stood still in that gap too:
+    // the amplifier's silences over 5 ms inside it (ms into the scenario, length, whether it
+    // resumed with the next counter). A whole-guest stall stops both; handd alone, only its.
+    let in_gap: Vec<String> = emg_silences(&seen, 5_000)
+        .iter()
+        .filter(|e| e.to_us > start + gap_at && e.from_us < start + gap_at + gap)
+        .map(|e| {
+            format!(
+                "{:.1} ms at {:.3} s{}",
+                e.len_us() as f64 * 1e-3,
+                (e.from_us - start) as f64 * 1e-6,
+                if e.in_sequence { "" } else { " (counter jump)" }
+            )
+        })
+        .collect();
     println!(
         "cia402 hand: handd's heartbeat on the bus: {} in {:.1} s, largest gap {:.1} ms (from \
-         {:.3} s into the scenario; the drives followed from {:.3} s); drives that lost it \
-         while handd ran (finger, us into the scenario): {lost:?}",
+         {:.3} s into the scenario; the drives followed from {:.3} s); the amplifier's \
+         silences in that gap: {in_gap:?}; drives that lost it while handd ran (finger, us \
+         into the scenario): {lost:?}",
         beats.len(),
         (kill_at - start) as f64 * 1e-6,
         gap as f64 * 1e-3,
