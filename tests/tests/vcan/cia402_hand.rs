@@ -182,6 +182,33 @@ fn j_every_finger_on_a_drive_tracks_one_trips_alone_and_all_stop_on_their_watchd
         gap_at as f64 * 1e-6,
         following_at.saturating_sub(start) as f64 * 1e-6
     );
+    if !lost.is_empty() {
+        // Whether handd's loop stood still or only its CANopen heartbeat went missing: its
+        // HAND_HEARTBEAT (0x300, every tick) in the same span, and what handd logged of late
+        // ticks (where their time went) and errors.
+        let from = start + gap_at;
+        let hand_beats: Vec<u64> = of(0x300, from.saturating_sub(100_000), from + gap + 100_000)
+            .iter()
+            .map(|f| f.0)
+            .collect();
+        let hand_gap = hand_beats
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .max()
+            .unwrap_or(0);
+        let log = handd.output();
+        let notable: Vec<&str> = log
+            .lines()
+            .filter(|l| l.contains("WARN") || l.contains("ERROR"))
+            .collect();
+        println!(
+            "cia402 hand: HAND_HEARTBEAT around that gap: largest gap {:.1} ms; handd's warnings \
+             and errors ({} lines, the last 20):\n{}",
+            hand_gap as f64 * 1e-3,
+            notable.len(),
+            notable[notable.len().saturating_sub(20)..].join("\n")
+        );
+    }
     assert!(
         lost.is_empty(),
         "drives stopped on their heartbeat watchdog while handd ran (largest gap between \
