@@ -185,7 +185,8 @@ fn j_every_finger_on_a_drive_tracks_one_trips_alone_and_all_stop_on_their_watchd
     if !lost.is_empty() {
         // Whether handd's loop stood still or only its CANopen heartbeat went missing: its
         // HAND_HEARTBEAT (0x300, every tick) in the same span, and what handd logged of late
-        // ticks (where their time went) and errors.
+        // ticks (where their time went), errors and state changes (a transmit queue refusing
+        // frames for long is `bus_degraded`).
         let from = start + gap_at;
         let hand_beats: Vec<u64> = of(0x300, from.saturating_sub(100_000), from + gap + 100_000)
             .iter()
@@ -199,11 +200,11 @@ fn j_every_finger_on_a_drive_tracks_one_trips_alone_and_all_stop_on_their_watchd
         let log = handd.output();
         let notable: Vec<&str> = log
             .lines()
-            .filter(|l| l.contains("WARN") || l.contains("ERROR"))
+            .filter(|l| l.contains("WARN") || l.contains("ERROR") || l.contains("state change"))
             .collect();
         println!(
-            "cia402 hand: HAND_HEARTBEAT around that gap: largest gap {:.1} ms; handd's warnings \
-             and errors ({} lines, the last 20):\n{}",
+            "cia402 hand: HAND_HEARTBEAT around that gap: largest gap {:.1} ms; handd's warnings, \
+             errors and state changes ({} lines, the last 20):\n{}",
             hand_gap as f64 * 1e-3,
             notable.len(),
             notable[notable.len().saturating_sub(20)..].join("\n")
