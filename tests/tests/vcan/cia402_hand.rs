@@ -11,7 +11,8 @@ use hand_dbc::messages::FingerSetpoint;
 use hand_model::nodes::DriveFingerConfig;
 use hand_model::patient::{Target, TrackingConfig};
 use handstack_tests::vcan::monitor::now_us;
-use handstack_tests::vcan::procs::handsim;
+use handstack_tests::vcan::procs::{handsim, DEADLINE_SLACK_MS};
+use handstack_tests::vcan::stall::StallMeter;
 use handstack_tests::vcan::stream_breaks::{emg_silences, judge_not_running};
 use handstack_tests::vcan::{scenario_start_us, Monitor, TestConfig, VcanEnv};
 
@@ -95,6 +96,11 @@ fn j_every_finger_on_a_drive_tracks_one_trips_alone_and_all_stop_on_their_watchd
         all_follow,
     );
     let following_at = now_us();
+    // Whether the machine ran while handd was late (`stall`): the CPU meters from here to the
+    // kill, and handd's late ticks over the same span.
+    let meter = StallMeter::start();
+    let mono_to_wall = now_us() as i64 - driver::rt::monotonic_us() as i64;
+    let st0 = cfg.status(&env);
     println!(
         "cia402 hand: all five drives follow their setpoints {:.0} ms after handsim started",
         t.as_secs_f64() * 1e3
@@ -122,6 +128,10 @@ fn j_every_finger_on_a_drive_tracks_one_trips_alone_and_all_stop_on_their_watchd
     if trip_seen.is_ok() {
         std::thread::sleep(Duration::from_millis(3_000));
     }
+    let st1 = cfg.status(&env);
+    let judged = meter
+        .stop()
+        .judge(&st0, &st1, u64::from(DEADLINE_SLACK_MS) * 1_000);
     let kill_at = now_us();
     handd.kill();
     std::thread::sleep(Duration::from_millis(600));
@@ -182,6 +192,43 @@ fn j_every_finger_on_a_drive_tracks_one_trips_alone_and_all_stop_on_their_watchd
         gap_at as f64 * 1e-6,
         following_at.saturating_sub(start) as f64 * 1e-6
     );
+    if gap > 75_000 {
+        // A beat missing: what handd put on the bus around it, tick by tick (its RPDO1s,
+        // SYNC, heartbeat, HAND_DIAG every tick, HAND_HEARTBEAT every other): a tick that
+        // did not run leaves no frame; one whose sends were refused, only its first frames.
+        let from = start + gap_at;
+        let handd_ids =
+            |id: u32| matches!(id, 0x07F | 0x77F | 0x300 | 0x301) || (0x205..=0x209).contains(&id);
+        let around: Vec<String> = frames
+            .iter()
+            .filter(|f| handd_ids(f.1) && f.0 + 5_000 >= from && f.0 <= from + gap + 5_000)
+            .map(|f| format!("{:+.1}:{:03X}", (f.0 as f64 - from as f64) * 1e-3, f.1))
+            .collect();
+        // The meters' gaps inside it (a CPU that ran nothing of the guest's), per CPU.
+        let stalled: Vec<String> = judged
+            .stalls
+            .gaps
+            .iter()
+            .map(|g| {
+                let wall = |t: u64| (t as i64 + mono_to_wall) as u64;
+                (g.cpu, wall(g.from_us), wall(g.to_us))
+            })
+            .filter(|&(_, a, b)| b > from && a < from + gap)
+            .map(|(cpu, a, b)| {
+                format!(
+                    "CPU {cpu} {:+.1}..{:+.1}",
+                    (a as f64 - from as f64) * 1e-3,
+                    (b as f64 - from as f64) * 1e-3
+                )
+            })
+            .collect();
+        println!(
+            "cia402 hand: handd's frames around its heartbeat's largest gap (ms from its last beat \
+             before it: id): {}\ncia402 hand: the CPU meters' gaps in it (ms, same origin): \
+             {stalled:?}\ncia402 hand: handd's loop from all five following to the kill: {judged}",
+            around.join(" ")
+        );
+    }
     if !lost.is_empty() {
         // Whether handd's loop stood still or only its CANopen heartbeat went missing: its
         // HAND_HEARTBEAT (0x300, every tick) in the same span, and what handd logged of late

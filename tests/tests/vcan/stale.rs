@@ -93,7 +93,7 @@ fn until_last_round(
 
 /// An ACTIVE setpoint of `epoch` for `FINGER` with alive counter `counter`, right CRC (E2E
 /// accepts it) and force of the velocity's sign (the controller moves only then). Returns
-/// when it was written.
+/// the time just before it was written.
 fn inject(w: &CanSocket, epoch: u16, counter: u8, velocity: f64) -> u64 {
     let sp = FingerSetpoint::new(
         FINGER,
@@ -111,8 +111,10 @@ fn inject(w: &CanSocket, epoch: u16, counter: u8, velocity: f64) -> u64 {
         false,
     );
     let out = socketcan::CanFrame::new(frame.id(), frame.data()).expect("a data frame");
+    // Stamped before the write, so no status that answers the frame is counted before it.
+    let at = now_us();
     w.write_frame(&out).expect("vcan takes the injected frame");
-    now_us()
+    at
 }
 
 #[test]
