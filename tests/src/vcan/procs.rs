@@ -270,6 +270,19 @@ impl TestConfig {
         p
     }
 
+    /// The status straight from the control socket, as `handctl status` asks for it, without
+    /// a process: for the drills that poll every 50 ms. Under the emulator each `handctl` run
+    /// (an exec and an exit of a 10 MB binary) costs the guest's kernel tens of ms.
+    pub fn query_status(&self) -> driver::protocol::Status {
+        use driver::protocol::{Reply, Request};
+        match driver::control::request(&self.socket, &Request::Status) {
+            Ok(Reply::Ok {
+                status: Some(s), ..
+            }) => s,
+            other => panic!("handd's status request: {other:?}"),
+        }
+    }
+
     /// `handctl status --json` against this daemon.
     pub fn status(&self, env: &VcanEnv) -> driver::protocol::Status {
         let sock = self.socket.display().to_string();

@@ -52,45 +52,39 @@ const RESET_COMMUNICATION: [u8; 2] = [0x82, 6];
 /// Polls `handctl status` until handd runs and the index drive's line satisfies `ok`, for at
 /// most `limit`; the time it took.
 fn wait_drive(
-    env: &VcanEnv,
     cfg: &TestConfig,
     what: &str,
     limit: Duration,
     ok: impl Fn(&DriveLine) -> bool,
 ) -> Duration {
-    wait_status(env, cfg, what, limit, true, ok)
+    wait_status(cfg, what, limit, true, ok)
 }
 
 /// [`wait_drive`], in any state of handd's unless `running` (a latched fault holds it in SAFE).
 fn wait_status(
-    env: &VcanEnv,
     cfg: &TestConfig,
     what: &str,
     limit: Duration,
     running: bool,
     ok: impl Fn(&DriveLine) -> bool,
 ) -> Duration {
-    wait_drives(env, cfg, what, limit, running, |d| {
-        d.first().is_some_and(&ok)
-    })
+    wait_drives(cfg, what, limit, running, |d| d.first().is_some_and(&ok))
 }
 
-/// Polls `handctl status` until every drive's line together satisfies `ok` (and handd runs, if
+/// Polls handd's status (as `handctl status` asks for it) until every drive's line together satisfies `ok` (and handd runs, if
 /// `running`), for at most `limit`; the time it took.
 pub(super) fn wait_drives(
-    env: &VcanEnv,
     cfg: &TestConfig,
     what: &str,
     limit: Duration,
     running: bool,
     ok: impl Fn(&[DriveLine]) -> bool,
 ) -> Duration {
-    poll_drives(env, cfg, what, limit, running, ok).unwrap_or_else(|e| panic!("{e}"))
+    poll_drives(cfg, what, limit, running, ok).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// [`wait_drives`], with the timeout as an error: what was asked and the last status seen.
 pub(super) fn poll_drives(
-    env: &VcanEnv,
     cfg: &TestConfig,
     what: &str,
     limit: Duration,
@@ -99,7 +93,7 @@ pub(super) fn poll_drives(
 ) -> Result<Duration, String> {
     let started = Instant::now();
     loop {
-        let st = cfg.status(env);
+        let st = cfg.query_status();
         if (!running || st.state == "RUNNING") && ok(&st.drives) {
             return Ok(started.elapsed());
         }
@@ -140,7 +134,6 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
     let sim_at = now_us();
     let following = |d: &DriveLine| d.state.starts_with("Operation enabled, following");
     let t = wait_drive(
-        &env,
         &cfg,
         "the index drive follows",
         Duration::from_secs(4),
@@ -151,13 +144,9 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
         t.as_secs_f64() * 1e3
     );
     // The trip: that finger stopped with the drive's EMCY named, the hand still RUNNING.
-    wait_drive(
-        &env,
-        &cfg,
-        "the trip is seen",
-        Duration::from_secs(5),
-        |d| d.faulted && d.state.contains("EMCY") && d.state.contains("0x2310"),
-    );
+    wait_drive(&cfg, "the trip is seen", Duration::from_secs(5), |d| {
+        d.faulted && d.state.contains("EMCY") && d.state.contains("0x2310")
+    });
     let tripped_at = now_us();
     println!(
         "cia402: status shows the drive's trip {:.0} ms after handsim's {TRIP_S} s",
@@ -166,7 +155,6 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
     std::thread::sleep(Duration::from_millis(500));
     let armed = Armed::now(&env, &cfg.socket);
     let t = wait_drive(
-        &env,
         &cfg,
         "the drive runs again after arm",
         Duration::from_secs(4),
@@ -179,7 +167,6 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
     );
     // The power cycle: its boot-up seen, the finger held until `arm`, then started again.
     wait_drive(
-        &env,
         &cfg,
         "the power cycle is seen",
         Duration::from_secs(6),
@@ -193,7 +180,6 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
     std::thread::sleep(Duration::from_millis(500));
     let rearmed = Armed::now(&env, &cfg.socket);
     let t = wait_drive(
-        &env,
         &cfg,
         "the drive runs again after the power cycle and arm",
         Duration::from_secs(4),
@@ -212,7 +198,6 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
         .write_frame(&busoff)
         .expect("vcan accepts an injected error frame");
     wait_status(
-        &env,
         &cfg,
         "the bus-off recovery is seen",
         Duration::from_secs(4),
@@ -222,7 +207,6 @@ fn i_cia402_index_finger_started_driven_and_stopped_by_its_watchdog() {
     std::thread::sleep(Duration::from_millis(500));
     let armed3 = Armed::now(&env, &cfg.socket);
     let t = wait_drive(
-        &env,
         &cfg,
         "the drive runs again after the bus-off and arm",
         Duration::from_secs(4),
