@@ -225,10 +225,11 @@ fn j_every_finger_on_a_drive_tracks_one_trips_alone_and_all_stop_on_their_watchd
         println!(
             "cia402 hand: handd's frames around its heartbeat's largest gap (ms from its last beat \
              before it: id): {}\ncia402 hand: the CPU meters' gaps in it (ms, same origin): \
-             {stalled:?}\ncia402 hand: handd's loop from all five following to the kill: {judged}",
+             {stalled:?}",
             around.join(" ")
         );
     }
+    println!("cia402 hand: handd's loop from all five following to the trip's end: {judged}");
     if !lost.is_empty() {
         // Whether handd's loop stood still or only its CANopen heartbeat went missing: its
         // HAND_HEARTBEAT (0x300, every tick) in the same span, and what handd logged of late
