@@ -271,8 +271,9 @@ impl TestConfig {
     }
 
     /// The status straight from the control socket, as `handctl status` asks for it, without
-    /// a process: for the drills that poll every 50 ms. Under the emulator each `handctl` run
-    /// (an exec and an exit of a 10 MB binary) costs the guest's kernel tens of ms.
+    /// a process: for the drills that poll every 50 ms. Under the emulator, running `handctl`
+    /// (the exec and exit of a 6 MB binary) 20 times a second stalled the guest's CPUs up to
+    /// 67 ms at a time, and handd's ticks with them (issue 29: README, "The real bus").
     pub fn query_status(&self) -> driver::protocol::Status {
         use driver::protocol::{Reply, Request};
         match driver::control::request(&self.socket, &Request::Status) {
