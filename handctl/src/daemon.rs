@@ -71,27 +71,41 @@ fn format_model(s: &Status) -> String {
     }
 }
 
-/// The status as a table.
+/// The status as a table: the model, the counters, the fingers, the drives, the late ticks.
 pub fn format_status(s: &Status) -> String {
     let mut out = format_model(s);
-    // invalid_window with its reason, when this handd reports one.
+    out += &counters_section(s);
+    out += &fingers_section(s);
+    out += &drives_section(&s.drives);
+    out += &late_ticks_section(&s.late_ticks);
+    out
+}
+
+/// State and faults (invalid_window with its reason, when this handd reports one), the
+/// engine's counters, the latency figures and the bus's.
+fn counters_section(s: &Status) -> String {
     let faults = match &s.window {
         Some(w) if s.faults.split(',').any(|f| f == "invalid_window") => {
             format!("{} (window: {w})", s.faults)
         }
         _ => s.faults.clone(),
     };
-    out += &format!(
+    let controller = if s.bus.controller.is_empty() {
+        "?"
+    } else {
+        &s.bus.controller
+    };
+    let c = &s.bus.counters;
+    format!(
         "state {}   faults {}\n\
          ticks {}   deadline misses {}   EMG samples lost {}   bad frames {}   windows beyond \
          the calibration {}   implausible {}\n\
          latency (newest sample -> setpoints) p50 {} us  p99 {} us  max {} us\n\
          compute per tick                     p50 {} us  p99 {} us  max {} us\n\
          tick start after its deadline        p50 {} us  p99 {} us  max {} us\n\
-         CAN controller {}   errors: warning {} passive {} bus-off {} restarted {} no-ACK {} \
-         overflow {} protocol {} other {}; transmit queue full {}; reopen failures {}; wall-clock \
-         steps {}; receive queue drops (kernel) {}\n\n\
-         {:<7} {:>7} {:>9} {:>11} {:>11} {:>7} {:>7}  {}\n",
+         CAN controller {controller}   errors: warning {} passive {} bus-off {} restarted {} \
+         no-ACK {} overflow {} protocol {} other {}; transmit queue full {}; reopen failures {}; \
+         wall-clock steps {}; receive queue drops (kernel) {}\n",
         s.state,
         faults,
         s.ticks,
@@ -109,31 +123,26 @@ pub fn format_status(s: &Status) -> String {
         s.lateness.p50_us,
         s.lateness.p99_us,
         s.lateness.max_us,
-        if s.bus.controller.is_empty() {
-            "?"
-        } else {
-            &s.bus.controller
-        },
-        s.bus.counters.warning,
-        s.bus.counters.passive,
-        s.bus.counters.bus_off,
-        s.bus.counters.restarted,
-        s.bus.counters.no_ack,
-        s.bus.counters.controller_overflow,
-        s.bus.counters.protocol,
-        s.bus.counters.other,
-        s.bus.counters.tx_queue_full,
-        s.bus.counters.reopen_failures,
-        s.bus.counters.clock_steps,
-        s.bus.counters.kernel_drops,
-        "finger",
-        "label",
-        "force N",
-        "vel rad/s",
-        "reported N",
-        "kf",
-        "kalpha",
-        "",
+        c.warning,
+        c.passive,
+        c.bus_off,
+        c.restarted,
+        c.no_ack,
+        c.controller_overflow,
+        c.protocol,
+        c.other,
+        c.tx_queue_full,
+        c.reopen_failures,
+        c.clock_steps,
+        c.kernel_drops,
+    )
+}
+
+/// One line per finger: label, setpoints, reported force, gains, disabled.
+fn fingers_section(s: &Status) -> String {
+    let mut out = format!(
+        "\n{:<7} {:>7} {:>9} {:>11} {:>11} {:>7} {:>7}  {}\n",
+        "finger", "label", "force N", "vel rad/s", "reported N", "kf", "kalpha", "",
     );
     for (f, st) in s.fingers.iter().enumerate() {
         out.push_str(&format!(
@@ -148,22 +157,28 @@ pub fn format_status(s: &Status) -> String {
             if st.disabled { "DISABLED" } else { "" }
         ));
     }
-    if !s.drives.is_empty() {
-        out += "\nCiA 402 drives\n";
-        for d in &s.drives {
-            out += &format!(
-                "{}{:<7} node {:>3}  {}\n",
-                if d.faulted { "!! " } else { "" },
-                d.finger,
-                d.node,
-                d.state
-            );
-            if let Some(detail) = drive_detail(d) {
-                out += &format!("{:18}{detail}\n", "");
-            }
+    out
+}
+
+/// The CiA 402 drives, a stopped one flagged (empty without drives).
+fn drives_section(drives: &[driver::protocol::DriveLine]) -> String {
+    let mut out = String::new();
+    if drives.is_empty() {
+        return out;
+    }
+    out += "\nCiA 402 drives\n";
+    for d in drives {
+        out += &format!(
+            "{}{:<7} node {:>3}  {}\n",
+            if d.faulted { "!! " } else { "" },
+            d.finger,
+            d.node,
+            d.state
+        );
+        if let Some(detail) = drive_detail(d) {
+            out += &format!("{:18}{detail}\n", "");
         }
     }
-    out += &late_ticks_section(&s.late_ticks);
     out
 }
 
@@ -265,6 +280,7 @@ fn drive_detail(d: &driver::protocol::DriveLine) -> Option<String> {
     Some(parts.join(", "))
 }
 
+/// The status as a table.
 #[cfg(test)]
 mod tests {
     use super::*;
