@@ -104,6 +104,51 @@ enum Step {
     Data { write: bool, address: u8, left: u8 },
 }
 
+impl Step {
+    /// The step after the chip has taken `b` (an opcode, a register count or a register's
+    /// value; RDATAC keeps the registers as they are).
+    fn written(self, s: &mut SimState, b: u8) -> Step {
+        match self {
+            Step::Opcode => decode(s, b),
+            Step::Count { write, address } => Step::Data {
+                write,
+                address,
+                left: (b & 0x1F) + 1,
+            },
+            Step::Data {
+                write,
+                address,
+                left,
+            } => {
+                if write && !s.rdatac && !read_only(address) {
+                    s.regs[usize::from(address)] = b;
+                }
+                next(write, address, left)
+            }
+        }
+    }
+
+    /// The byte the chip shifts out on a read here (a register's value inside RREG, 0
+    /// elsewhere and in RDATAC), and the step after it.
+    fn read(self, s: &SimState) -> (u8, Step) {
+        match self {
+            Step::Data {
+                write: false,
+                address,
+                left,
+            } => {
+                let out = if s.rdatac {
+                    0
+                } else {
+                    s.regs[usize::from(address)]
+                };
+                (out, next(false, address, left))
+            }
+            other => (0, other),
+        }
+    }
+}
+
 impl ErrorType for SimAds1299 {
     type Error = ErrorKind;
 }
@@ -142,41 +187,13 @@ impl SpiDevice for SimAds1299 {
                 Operation::Write(bytes) => {
                     for &b in bytes.iter() {
                         byte_gap(&mut s, &mut since);
-                        step = match step {
-                            Step::Opcode => decode(&mut s, b),
-                            Step::Count { write, address } => Step::Data {
-                                write,
-                                address,
-                                left: (b & 0x1F) + 1,
-                            },
-                            Step::Data {
-                                write,
-                                address,
-                                left,
-                            } => {
-                                if write && !s.rdatac && !read_only(address) {
-                                    s.regs[usize::from(address)] = b;
-                                }
-                                next(write, address, left)
-                            }
-                        };
+                        step = step.written(&mut s, b);
                     }
                 }
                 Operation::Read(buf) => {
                     for out in buf.iter_mut() {
                         byte_gap(&mut s, &mut since);
-                        *out = 0;
-                        if let Step::Data {
-                            write: false,
-                            address,
-                            left,
-                        } = step
-                        {
-                            if !s.rdatac {
-                                *out = s.regs[usize::from(address)];
-                            }
-                            step = next(false, address, left);
-                        }
+                        (*out, step) = step.read(&s);
                     }
                 }
                 _ => return Err(ErrorKind::Other),
