@@ -419,13 +419,40 @@ fn required_sections_are_listed_and_an_unknown_one_is_refused() {
     let mut p = split(&bytes);
     assert_eq!(
         p.meta["required"],
-        serde_json::json!(["rest_stage", "envelope", "envelope_alone"])
+        serde_json::json!([
+            "rest_stage",
+            "envelope",
+            "envelope_alone",
+            "envelope_patterns"
+        ])
     );
     let load = |b: &[u8]| TrainedModel::from_bytes(b, Some(&chain(2)));
     let back = load(&join(&p)).expect("loads");
     let alone = with_stage.envelope().and_then(|e| e.alone());
     assert!(alone.is_some_and(|a| a >= 1.0), "{alone:?}");
     assert_eq!(back.envelope().and_then(|e| e.alone()), alone);
+    let cone = with_stage.envelope().and_then(|e| e.cone()).cloned();
+    assert!(cone.is_some(), "training records the channel patterns");
+    assert_eq!(back.envelope().and_then(|e| e.cone()), cone.as_ref());
+    // So do the channel patterns: listed, and an older file without them loads with the
+    // pattern test off.
+    p.meta["required"] = serde_json::json!(["rest_stage", "envelope", "envelope_alone"]);
+    let e = load(&join(&p)).unwrap_err();
+    assert!(e.to_string().contains("envelope_patterns"), "{e}");
+    let patterns = p.meta.as_object_mut().unwrap().remove("envelope_patterns");
+    let older = load(&join(&p)).expect("an envelope without the patterns loads");
+    assert_eq!(older.envelope().and_then(|e| e.cone()), None);
+    p.meta["envelope_patterns"] = patterns.unwrap();
+    p.meta["envelope_patterns"]["worst"] = serde_json::json!(2.0);
+    p.meta["required"] = serde_json::json!([
+        "rest_stage",
+        "envelope",
+        "envelope_alone",
+        "envelope_patterns"
+    ]);
+    let e = load(&join(&p)).unwrap_err();
+    assert!(e.to_string().contains("worst misfit"), "{e}");
+    p.meta.as_object_mut().unwrap().remove("envelope_patterns");
     // The calibration's channel ratio changes the outputs: it must be listed, and it needs
     // the envelope it belongs to.
     p.meta["required"] = serde_json::json!(["rest_stage", "envelope"]);

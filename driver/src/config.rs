@@ -250,8 +250,9 @@ impl Default for DeployConfig {
 }
 
 /// The input plausibility check (issue 25): a window with one channel standing alone (a
-/// pressed, lifted, knocked or hit electrode, not an effort) gives rest and raises
-/// `signal_quality` for as long as it lasts.
+/// pressed, lifted, knocked or hit electrode, not an effort), or whose channel pattern lies off
+/// every combination of the calibration's movements (a band turned on the forearm), gives rest
+/// and raises `signal_quality` for as long as it lasts.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PlausibilityConfig {
@@ -263,12 +264,20 @@ pub struct PlausibilityConfig {
     /// smaller artefacts and risks stopping a genuine uneven contraction; higher the reverse.
     /// 1.5 to 100.
     pub spread: f64,
+    /// A window is implausible when its top channel is above the floor and its per-channel
+    /// power misfits the calibration's channel patterns by more than `pattern_margin` times the
+    /// worst misfit of the calibration's own windows (at least
+    /// `decoder::model::CONE_LEAST`; `decoder::model::PatternCone`). Lower catches a smaller
+    /// turn of the band and risks stopping a genuine combination of movements; higher the
+    /// reverse. 1.2 to 100.
+    pub pattern_margin: f64,
 }
 
 impl Default for PlausibilityConfig {
     fn default() -> Self {
         Self {
             spread: decoder::model::PLAUSIBLE_SPREAD,
+            pattern_margin: decoder::model::CONE_MARGIN,
         }
     }
 }
@@ -449,6 +458,11 @@ impl Config {
             "plausibility.spread".into(),
             self.plausibility.spread,
             (1.5, 100.0),
+        )?;
+        check_f64(
+            "plausibility.pattern_margin".into(),
+            self.plausibility.pattern_margin,
+            (1.2, 100.0),
         )?;
         if !(1..=10_000_000).contains(&self.deploy.min_rays) {
             return Err(ConfigError::Invalid {
@@ -631,6 +645,27 @@ mod tests {
             Config::default().plausibility.spread,
             decoder::model::PLAUSIBLE_SPREAD
         );
+        let c = Config::from_toml(
+            "[plausibility]\npattern_margin = 3.0\n",
+            Path::new("h.toml"),
+        )
+        .unwrap();
+        assert_eq!(crate::startup::engine_settings(&c, 0).pattern_margin, 3.0);
+        assert_eq!(
+            Config::default().plausibility.pattern_margin,
+            decoder::model::CONE_MARGIN
+        );
+        for bad in ["1.1", "101.0"] {
+            let e = Config::from_toml(
+                &format!("[plausibility]\npattern_margin = {bad}\n"),
+                Path::new("h.toml"),
+            )
+            .unwrap_err();
+            assert!(
+                e.to_string().contains("plausibility.pattern_margin"),
+                "{bad}: {e}"
+            );
+        }
         for bad in ["1.0", "101.0", "nan"] {
             let e = Config::from_toml(
                 &format!("[plausibility]\nspread = {bad}\n"),

@@ -170,6 +170,7 @@ pub fn engine_settings(config: &Config, model_id: u32) -> EngineSettings {
         gains: std::array::from_fn::<_, N_FINGERS, _>(|f| config.fingers.get(f).gains()),
         model_id,
         plausible_spread: config.plausibility.spread,
+        pattern_margin: config.plausibility.pattern_margin,
         drives: config
             .drives()
             .unwrap_or_else(|e| panic!("the config was validated before: {e}")),

@@ -103,7 +103,55 @@ fn main() {
     assert_eq!(stats.reallocations, 0, "heap reallocations in the tick");
     with_a_cia402_drive(&frames, hand_canopen::Mode::CyclicSyncTorque);
     with_a_cia402_drive(&frames, hand_canopen::Mode::CyclicSyncVelocity);
-    println!("tick_alloc: 3 passed, 0 failed");
+    with_every_plausibility_test(&frames);
+    println!("tick_alloc: 4 passed, 0 failed");
+}
+
+/// The same traffic through a model with a calibration envelope and channel patterns, made so
+/// that every path of the plausibility check runs in the tick: the envelope's maximum is low
+/// (windows are moved back into it), and the patterns are two single channels, which no
+/// window of the whole hand fits (the full pattern fit runs; the window is implausible).
+fn with_every_plausibility_test(frames: &[(u64, CanFrame)]) {
+    use decoder::model::{Envelope, PatternCone};
+    let chain = decoder::dsp::ChainConfig::default();
+    let n = chain.channels;
+    let single = |c: usize| (0..n).map(|i| f64::from(u8::from(i == c))).collect();
+    let envelope = Envelope::try_new(vec![20.0; 8 * n])
+        .and_then(|e| e.with_alone(Some(2.0)))
+        .and_then(|e| {
+            e.with_cone(Some(
+                PatternCone::try_new(n, vec![single(0), single(6)], 0.0).expect("cone"),
+            ))
+        })
+        .expect("envelope");
+    let predictor = common::random_model(3)
+        .with_envelope(Some(envelope))
+        .expect("envelope")
+        .predictor();
+    let settings = chain.validate().expect("chain");
+    let mut engine = Engine::new(&settings, predictor, EngineSettings::default(), 0);
+    engine.validated(0);
+    let (mut next, mut deadline) = (0usize, 50_000u64);
+    let region = Region::new(GLOBAL);
+    while deadline <= 10_000_000 {
+        while next < frames.len() && frames[next].0 <= deadline {
+            engine.on_frame(&frames[next].1, frames[next].0);
+            next += 1;
+        }
+        engine.tick(deadline, deadline);
+        engine.written(deadline + 20, 20);
+        deadline += 50_000;
+    }
+    let stats = region.change();
+    let c = engine.counters();
+    println!(
+        "every plausibility test: {} ticks, {} windows beyond the calibration, {} implausible: \
+         {} allocations, {} reallocations",
+        c.ticks, c.beyond_calibration, c.implausible, stats.allocations, stats.reallocations
+    );
+    assert!(c.implausible > 0, "the pattern fit ran");
+    assert_eq!(stats.allocations, 0, "heap allocations in the tick");
+    assert_eq!(stats.reallocations, 0, "heap reallocations in the tick");
 }
 
 /// The same traffic with the index finger on a live simulated CiA 402 drive (node 6, in `mode`:

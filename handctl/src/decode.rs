@@ -97,12 +97,22 @@ fn envelope_line(model: &TrainedModel, d: &Decoded) -> String {
     match model.envelope() {
         Some(e) => format!(
             "beyond the calibration: {} windows moved back into its envelope, {} implausible \
-             (one channel standing alone: output rest; {}); {range}",
+             (one channel standing alone, or a shape off the calibration's channel patterns: \
+             output rest; {}; {}); {range}",
             d.beyond,
             d.implausible,
             match e.alone() {
                 Some(a) => format!("the calibration's channels reached {a:.2}x the next"),
                 None => "no channel ratio recorded: the alone test is off".into(),
+            },
+            match e.cone() {
+                Some(c) if c.bar() >= 1.0 => format!(
+                    "its windows fit its channel patterns only to {:.2}: the pattern test \
+                     cannot fire",
+                    c.worst()
+                ),
+                Some(c) => format!("patterns misfit above {:.3}", c.bar()),
+                None => "no channel patterns recorded: the pattern test is off".into(),
             }
         ),
         None => format!(

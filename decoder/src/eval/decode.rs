@@ -22,7 +22,8 @@ pub struct Decoded {
     pub reference: Option<(String, Vec<f64>)>,
     /// Windows beyond the calibration's envelope, moved back into it (issue 25).
     pub beyond: usize,
-    /// Windows with one channel standing alone (far above the next): output rest.
+    /// Implausible windows (one channel standing alone, or a shape off the calibration's
+    /// channel patterns): output rest.
     pub implausible: usize,
 }
 

@@ -50,6 +50,12 @@
 //!   the other channels scaled below rest, and the other fingers move up to 0.42 while asked
 //!   to rest (issue 25: a projection that keeps the rest level would let it go).
 //!
+//! - *off the patterns* (when the file records the calibration's channel patterns): the top
+//!   channel is above [`PLAUSIBLE_FLOOR`] and the window's per-channel power lies farther from
+//!   every non-negative combination of the calibration's movements than the calibration's own
+//!   windows did, by [`super::CONE_MARGIN`] ([`PatternCone`]: a band turned around the
+//!   forearm, with the figures of where it can fire and where it cannot).
+//!
 //! An implausible window gives no movement: the predictor outputs rest (0) for it, and the
 //! daemon raises `signal_quality`.
 //!
@@ -58,6 +64,7 @@
 
 use crate::dsp::{FEATURES_PER_CHANNEL, FEATURE_NAMES};
 
+use super::cone::PatternCone;
 use super::error::ModelError;
 
 /// The plausibility check's spread (see [`Envelope::implausible`]): the least ratio of the top
@@ -95,6 +102,9 @@ pub struct Envelope {
     /// above [`PLAUSIBLE_FLOOR`]): what "alone" means on this patient's electrodes. None for a
     /// file written before it was recorded, or one channel: the *alone* test is then off.
     alone: Option<f64>,
+    /// The calibration's channel patterns (the *off the patterns* test); None for a file
+    /// written before they were recorded: the test is then off.
+    cone: Option<PatternCone>,
 }
 
 /// The index of VAR among a channel's features.
@@ -138,6 +148,7 @@ impl Envelope {
             rms,
             spread: PLAUSIBLE_SPREAD,
             alone: None,
+            cone: None,
         })
     }
 
@@ -206,39 +217,137 @@ impl Envelope {
         self.alone
     }
 
+    /// The envelope with the calibration's channel patterns fitted from its windows: `rows`
+    /// (raw feature vectors) with each window's per-finger targets (+ flexion, - extension,
+    /// 0 rest). With more movements than [`super::MAX_PATTERNS`] the test stays off.
+    pub fn with_patterns<'a>(
+        self,
+        windows: impl Iterator<Item = (&'a [f64], &'a [f64; 5])>,
+    ) -> Result<Self, ModelError> {
+        let channels = self.channels();
+        if channels > MAX_CHANNELS {
+            return Ok(self);
+        }
+        let mut rows: Vec<(Vec<f64>, [i8; 5], bool)> = Vec::new();
+        for (x, t) in windows {
+            if x.len() != self.max.len() {
+                return Err(ModelError::Shape {
+                    what: "calibration window".into(),
+                    expected: self.max.len(),
+                    found: x.len(),
+                });
+            }
+            let mut power = [0.0f64; MAX_CHANNELS];
+            let top = self.powers(x, &mut power);
+            let key = t.map(|v| i8::from(v > 0.0) - i8::from(v < 0.0));
+            rows.push((power[..channels].to_vec(), key, top > PLAUSIBLE_FLOOR));
+        }
+        let cone = PatternCone::fit(
+            channels,
+            rows.iter().map(|(p, k, c)| (p.as_slice(), *k, *c)),
+        )?;
+        Ok(Self { cone, ..self })
+    }
+
+    /// The envelope with `cone` as the calibration's channel patterns (from a file).
+    pub fn with_cone(self, cone: Option<PatternCone>) -> Result<Self, ModelError> {
+        if let Some(c) = &cone {
+            if c.channels() != self.channels() {
+                return Err(ModelError::Shape {
+                    what: "channel patterns".into(),
+                    expected: self.channels(),
+                    found: c.channels(),
+                });
+            }
+        }
+        Ok(Self { cone, ..self })
+    }
+
+    /// The calibration's channel patterns, when recorded.
+    pub fn cone(&self) -> Option<&PatternCone> {
+        self.cone.as_ref()
+    }
+
+    /// Per channel of `x`, its power (level squared) into `power`; returns the top level.
+    /// Infinite for a channel the calibration never saw move (its largest RMS 0).
+    #[inline]
+    fn powers(&self, x: &[f64], power: &mut [f64; MAX_CHANNELS]) -> f64 {
+        let mut top = 0.0f64;
+        for (c, p) in power
+            .iter_mut()
+            .enumerate()
+            .take(self.channels().min(MAX_CHANNELS))
+        {
+            let e = self.level(x, c);
+            top = top.max(e);
+            *p = e * e;
+        }
+        top
+    }
+
     /// The guard beyond the calibration, one line for a technician (`handctl status`): for
     /// `None`, a model file without an envelope. The flag is true when a guard is missing that
     /// a model trained today has (the envelope, or the alone test on two or more channels).
     pub fn describe(envelope: Option<&Self>) -> (String, bool) {
-        match envelope {
-            None => (
+        let Some(e) = envelope else {
+            return (
                 "beyond the calibration: NOT bounded (the file has no calibration envelope: \
                  an older model; retrain it to get the guard)"
                     .into(),
                 true,
-            ),
-            Some(e) if e.channels() < 2 => (
-                "beyond the calibration: bounded by its envelope (one channel: no alone test)"
-                    .into(),
+            );
+        };
+        let (alone, alone_missing) = match e.alone {
+            _ if e.channels() < 2 => (
+                "bounded by its envelope (one channel: no alone test)".to_string(),
                 false,
             ),
-            Some(e) => match e.alone {
-                Some(a) => (
-                    format!(
-                        "beyond the calibration: bounded by its envelope; a channel standing \
-                         alone is implausible (the calibration's reached {a:.2}x the next)"
-                    ),
-                    false,
+            Some(a) => (
+                format!(
+                    "bounded by its envelope; a channel standing alone is implausible (the \
+                     calibration's reached {a:.2}x the next)"
                 ),
-                None => (
-                    "beyond the calibration: bounded by its envelope; the alone test is OFF \
-                     (the file records no channel ratio: an older model, so a knocked electrode \
-                     at rest is not caught; retrain it to get the test)"
-                        .into(),
-                    true,
+                false,
+            ),
+            None => (
+                "bounded by its envelope; the alone test is OFF (the file records no channel \
+                 ratio: an older model, so a knocked electrode at rest is not caught; retrain \
+                 it to get the test)"
+                    .to_string(),
+                true,
+            ),
+        };
+        let (patterns, patterns_missing) = match &e.cone {
+            None => (
+                "the pattern test is OFF (the file records no channel patterns: an older \
+                 model, so a band turned on the forearm is not caught; retrain it to get the \
+                 test)"
+                    .to_string(),
+                true,
+            ),
+            Some(c) if c.bar() >= 1.0 => (
+                format!(
+                    "the pattern test cannot fire on this calibration (its own windows fit its \
+                     channel patterns only to {:.2})",
+                    c.worst()
                 ),
-            },
-        }
+                false,
+            ),
+            Some(c) => (
+                format!(
+                    "a window off the calibration's {} channel patterns is implausible (misfit \
+                     above {:.3}; the calibration's reached {:.3})",
+                    c.patterns().count(),
+                    c.bar(),
+                    c.worst()
+                ),
+                false,
+            ),
+        };
+        (
+            format!("beyond the calibration: {alone}; {patterns}"),
+            alone_missing || patterns_missing,
+        )
     }
 
     /// Channels the envelope covers.
@@ -337,7 +446,32 @@ impl Envelope {
             }
             _ => false,
         };
-        alone || beyond_alone
+        alone || beyond_alone || self.off_patterns(x, top)
+    }
+
+    /// The misfit of `x`'s channel powers against the calibration's patterns, when the file
+    /// records them and the top channel is above [`PLAUSIBLE_FLOOR`] (what the *off the
+    /// patterns* test compares with its bar). No allocation.
+    pub fn pattern_misfit(&self, x: &[f64]) -> Option<f64> {
+        let cone = self.cone.as_ref()?;
+        let mut power = [0.0f64; MAX_CHANNELS];
+        let top = self.powers(x, &mut power);
+        (top > PLAUSIBLE_FLOOR && top.is_finite()).then(|| cone.misfit(&power[..cone.channels()]))
+    }
+
+    /// The *off the patterns* test: the top channel above the floor (and finite) and the
+    /// window's channel powers off the calibration's cone.
+    #[inline]
+    fn off_patterns(&self, x: &[f64], top: f64) -> bool {
+        let Some(cone) = &self.cone else {
+            return false;
+        };
+        if !(top > PLAUSIBLE_FLOOR && top.is_finite()) {
+            return false;
+        }
+        let mut power = [0.0f64; MAX_CHANNELS];
+        self.powers(x, &mut power);
+        cone.off(&power[..cone.channels()])
     }
 
     /// Sets the plausibility check's spread (see [`Envelope::implausible`]); `spread` must be
@@ -345,6 +479,14 @@ impl Envelope {
     pub fn set_spread(&mut self, spread: f64) {
         debug_assert!(spread.is_finite() && spread > 1.0, "spread {spread}");
         self.spread = spread;
+    }
+
+    /// Sets the *off the patterns* test's margin over the calibration's own worst misfit (see
+    /// [`PatternCone::set_margin`]); nothing without recorded patterns.
+    pub fn set_pattern_margin(&mut self, margin: f64) {
+        if let Some(c) = &mut self.cone {
+            c.set_margin(margin);
+        }
     }
 
     /// The plausibility check's spread.
@@ -384,11 +526,50 @@ mod tests {
         assert!(flagged && text.contains("NOT bounded"), "{text}");
         let (text, flagged) = Envelope::describe(Some(&unit(12)));
         assert!(flagged && text.contains("alone test is OFF"), "{text}");
-        let on = unit(12).with_alone(Some(2.36)).expect("ratio");
+        let cone = |channels: usize, worst: f64| {
+            PatternCone::try_new(
+                channels,
+                vec![vec![1.0 / (channels as f64).sqrt(); channels]],
+                worst,
+            )
+            .expect("cone")
+        };
+        let alone_only = unit(12).with_alone(Some(2.36)).expect("ratio");
+        let (text, flagged) = Envelope::describe(Some(&alone_only));
+        assert!(flagged && text.contains("pattern test is OFF"), "{text}");
+        let on = alone_only.with_cone(Some(cone(12, 0.035))).expect("cone");
         let (text, flagged) = Envelope::describe(Some(&on));
         assert!(!flagged && text.contains("2.36x the next"), "{text}");
-        let (text, flagged) = Envelope::describe(Some(&unit(1)));
+        assert!(text.contains("misfit above 0.070"), "{text}");
+        let noisy = on.clone().with_cone(Some(cone(12, 0.68))).expect("cone");
+        let (text, flagged) = Envelope::describe(Some(&noisy));
+        assert!(!flagged && text.contains("cannot fire"), "{text}");
+        let one = unit(1).with_cone(Some(cone(1, 0.0))).expect("cone");
+        let (text, flagged) = Envelope::describe(Some(&one));
         assert!(!flagged && text.contains("one channel"), "{text}");
+        assert!(unit(2).with_cone(Some(cone(3, 0.0))).is_err());
+    }
+
+    #[test]
+    fn a_window_off_the_calibrations_patterns_is_implausible() {
+        // Two channels; the calibration moved them together only.
+        let e = unit(2)
+            .with_cone(Some(
+                PatternCone::try_new(2, vec![vec![0.5f64.sqrt(); 2]], 0.01).expect("cone"),
+            ))
+            .expect("cone");
+        let rms = |a: f64, b: f64| {
+            let mut x = vec![0.0; 2 * FEATURES_PER_CHANNEL];
+            x[e.rms] = a;
+            x[FEATURES_PER_CHANNEL + e.rms] = b;
+            x
+        };
+        assert!(!e.implausible(&rms(0.5, 0.5)));
+        assert!(e.implausible(&rms(0.5, 0.3)), "a shape it never saw");
+        assert!(
+            !e.implausible(&rms(0.05, 0.03)),
+            "below the floor it is rest"
+        );
     }
 
     #[test]

@@ -72,7 +72,13 @@ pub const FORMAT_VERSION: u32 = 2;
 /// The oldest format version this build reads.
 pub const OLDEST_VERSION: u32 = 1;
 /// The metadata sections this build knows how to apply, of those a file may mark `required`.
-pub const KNOWN_REQUIRED: &[&str] = &["rest_stage", "envelope", "envelope_alone", "taught"];
+pub const KNOWN_REQUIRED: &[&str] = &[
+    "rest_stage",
+    "envelope",
+    "envelope_alone",
+    "envelope_patterns",
+    "taught",
+];
 /// Header length in bytes.
 pub const HEADER_LEN: usize = 24;
 /// Name of the normalizer tensor in the metadata and in errors.
@@ -115,6 +121,11 @@ struct Meta {
     /// one channel): the plausibility check's *alone* test ([`super::Envelope::implausible`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     envelope_alone: Option<f64>,
+    /// The calibration's channel patterns (absent in older files, and when the calibration
+    /// had more movements than a cone holds): the plausibility check's *off the patterns*
+    /// test ([`super::PatternCone`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    envelope_patterns: Option<PatternRecord>,
     /// The directions the calibration taught, per finger (absent in older files, and when both
     /// directions of every finger were taught: the stage is then the identity).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -125,6 +136,15 @@ struct Meta {
     /// The sections present that change the outputs (version 2 on; see the module docs).
     #[serde(default)]
     required: Vec<String>,
+}
+
+/// The channel patterns as a file holds them.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct PatternRecord {
+    /// One per movement, a power per channel (unit length).
+    patterns: Vec<Vec<f64>>,
+    /// The calibration's own worst misfit.
+    worst: f64,
 }
 
 const FORMAT_NAME: &str = "handstack-model";
@@ -246,6 +266,17 @@ fn read_meta(version: u32, body: &[u8]) -> Result<(Meta, &[u8]), FileError> {
         return Err(malformed(
             "envelope_alone present but not listed in required".into(),
         ));
+    }
+    if version >= 2
+        && meta.envelope_patterns.is_some()
+        && !meta.required.iter().any(|r| r == "envelope_patterns")
+    {
+        return Err(malformed(
+            "envelope_patterns present but not listed in required".into(),
+        ));
+    }
+    if meta.envelope_patterns.is_some() && meta.envelope.is_none() {
+        return Err(malformed("envelope_patterns without an envelope".into()));
     }
     if meta.envelope_alone.is_some() && meta.envelope.is_none() {
         return Err(malformed("envelope_alone without an envelope".into()));
@@ -448,6 +479,12 @@ impl TrainedModel {
             rest_stage: self.rest_stage,
             envelope: self.envelope.as_ref().map(|e| e.max().to_vec()),
             envelope_alone: self.envelope.as_ref().and_then(|e| e.alone()),
+            envelope_patterns: self.envelope.as_ref().and_then(|e| e.cone()).map(|c| {
+                PatternRecord {
+                    patterns: c.patterns().map(<[f64]>::to_vec).collect(),
+                    worst: c.worst(),
+                }
+            }),
             taught: (!self.taught.is_both()).then_some(self.taught),
             provenance: self.provenance.clone(),
             required: [
@@ -457,6 +494,10 @@ impl TrainedModel {
                     .as_ref()
                     .and_then(|e| e.alone())
                     .map(|_| "envelope_alone"),
+                self.envelope
+                    .as_ref()
+                    .and_then(|e| e.cone())
+                    .map(|_| "envelope_patterns"),
                 (!self.taught.is_both()).then_some("taught"),
             ]
             .into_iter()
@@ -515,8 +556,20 @@ impl TrainedModel {
         .with_taught(meta.taught.unwrap_or_default());
         match meta.envelope {
             Some(max) => {
+                let cone = meta
+                    .envelope_patterns
+                    .map(|r| {
+                        super::PatternCone::try_new(
+                            n_in / FEATURES_PER_CHANNEL,
+                            r.patterns,
+                            r.worst,
+                        )
+                    })
+                    .transpose()
+                    .map_err(|e| FileError::Malformed(format!("envelope: {e}")))?;
                 let envelope = super::Envelope::try_new(max)
                     .and_then(|e| e.with_alone(meta.envelope_alone))
+                    .and_then(|e| e.with_cone(cone))
                     .map_err(|e| FileError::Malformed(format!("envelope: {e}")))?;
                 trained
                     .with_envelope(Some(envelope))

@@ -433,7 +433,8 @@ pub fn train(
     let normalizer = Normalizer::fit(nf, split.train.iter().map(|&i| data.row(i)))?;
     // Every window of the calibration (the validation part too: it is the patient's signal all
     // the same) bounds what the model may see.
-    let envelope = super::Envelope::fit(nf, (0..data.len()).map(|i| data.row(i)))?;
+    let envelope = super::Envelope::fit(nf, (0..data.len()).map(|i| data.row(i)))?
+        .with_patterns((0..data.len()).map(|i| (data.row(i), data.target(i))))?;
     let beyond = cfg.effort.is_some_and(|e| e.beyond > 0);
     let set = Normalized::new(data, &normalizer, beyond.then_some(&envelope));
     let mut model = AnyModel::init(kind, spec, nf, N_FINGERS, &mut rng)?;

@@ -328,14 +328,22 @@ impl Predictor {
         }
     }
 
+    /// Sets the margin of the envelope's *off the patterns* test (when the model records the
+    /// calibration's channel patterns); see [`Envelope::set_pattern_margin`].
+    pub fn set_pattern_margin(&mut self, margin: f64) {
+        if let Some(e) = &mut self.envelope {
+            e.set_pattern_margin(margin);
+        }
+    }
+
     /// The signal scale the envelope applied to the last window (1: inside the calibration,
     /// or no envelope).
     pub fn last_scale(&self) -> f64 {
         self.last_scale
     }
 
-    /// Whether the last window was implausible (one channel standing alone, more than the
-    /// spread above the next: see [`Envelope::implausible`]); its output was rest.
+    /// Whether the last window was implausible (one channel standing alone, or a shape off the
+    /// calibration's channel patterns: see [`Envelope::implausible`]); its output was rest.
     pub fn last_implausible(&self) -> bool {
         self.last_implausible
     }

@@ -69,6 +69,9 @@ pub struct EngineSettings {
     /// The spread of the input plausibility check (`decoder::model::Envelope::implausible`),
     /// applied to every model the engine runs.
     pub plausible_spread: f64,
+    /// The margin of the plausibility check's *off the patterns* test over the calibration's
+    /// own worst misfit (`decoder::model::PatternCone::bar`), applied to every model.
+    pub pattern_margin: f64,
     /// Each finger's drive: native (hand.dbc's FINGER_SETPOINT) or a CiA 402 drive.
     pub drives: crate::drive_config::Drives,
 }
@@ -85,6 +88,7 @@ impl Default for EngineSettings {
             gains: [FingerGains::default(); N_FINGERS],
             model_id: 0,
             plausible_spread: decoder::model::PLAUSIBLE_SPREAD,
+            pattern_margin: decoder::model::CONE_MARGIN,
             drives: crate::drive_config::Drives::default(),
         }
     }
@@ -207,6 +211,7 @@ impl Engine {
     ) -> Self {
         if let Some(p) = &mut predictor {
             p.set_plausible_spread(settings.plausible_spread);
+            p.set_pattern_margin(settings.pattern_margin);
         }
         assert!(
             chain.n_channels() <= hand_dbc::emg::EMG_CHANNELS,

@@ -151,6 +151,7 @@ impl Engine {
         if fits {
             if let Some(p) = &mut m.predictor {
                 p.set_plausible_spread(self.settings.plausible_spread);
+                p.set_pattern_margin(self.settings.pattern_margin);
             }
             std::mem::swap(&mut self.predictor, &mut m.predictor);
             std::mem::swap(&mut self.settings.model_id, &mut m.model_id);

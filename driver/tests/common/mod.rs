@@ -24,6 +24,11 @@ use hand_model::{Clock, MemBus, MemEndpoint, VirtualClock};
 /// A model with random weights and unit scaling: enough to exercise the loop and its safety
 /// rules (the labels it gives are meaningless).
 pub fn random_predictor(seed: u64) -> Predictor {
+    random_model(seed).predictor()
+}
+
+/// The model behind [`random_predictor`].
+pub fn random_model(seed: u64) -> TrainedModel {
     let chain = ChainConfig::default();
     let n_in = 8 * chain.channels;
     let spec = ModelSpec::default();
@@ -31,9 +36,7 @@ pub fn random_predictor(seed: u64) -> Predictor {
     let summary = TrainingSummary::untrained(ModelKind::ResDd);
     // Features are in µV; scale them down so labels stay in a sensible range.
     let norm = Normalizer::from_scales(vec![100.0; n_in]).unwrap();
-    TrainedModel::new(model, spec, norm, chain, summary)
-        .unwrap()
-        .predictor()
+    TrainedModel::new(model, spec, norm, chain, summary).unwrap()
 }
 
 /// A model trained on a simulated calibration (the demo's recording and training), once per

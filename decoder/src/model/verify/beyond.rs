@@ -13,13 +13,16 @@
 //!   predictor's output differs from the polynomial's at `k_e` is counted as `not_held` (a
 //!   failure: the proof would not describe the deployed path);
 //! - a window whose shape the calibration never saw (one channel standing alone, far above the
-//!   next: [`crate::model::Envelope::implausible`]) outputs rest. Along a ray the channels'
-//!   ratios are fixed, so a ray turns implausible only where its top channel passes the
-//!   floor, at some `k_r`, and stays so beyond: the output drops to 0, towards rest, not the
+//!   next, or channel powers off the calibration's patterns:
+//!   [`crate::model::Envelope::implausible`]) outputs rest. Along a ray the channels' ratios
+//!   are fixed (and a pattern's misfit does not change with its scale), so a ray turns
+//!   implausible only where its top channel passes the floor, at some `k_r`, and stays so
+//!   beyond: the output drops to 0, towards rest, not the
 //!   wrong way. Those rays are counted (`resting`), and the drop is not a reversal; `k_r` is
 //!   found by bisection on the predictor. (A calibration window standing alone itself would
 //!   turn implausible before its edge; none does on P4, P6 and P7, where the top channel is
-//!   at most 1.79x the next.)
+//!   at most 1.79x the next; and none is off the patterns: the bar is above the worst of the
+//!   calibration's own windows.)
 //!
 //! A model without an envelope (an older file) is analysed on the whole `[0, K]`. MLP and CNN
 //! are sampled at [`super::SAMPLED_POINTS`] efforts over the same interval.
