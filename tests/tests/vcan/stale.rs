@@ -4,8 +4,14 @@
 //! setpoint of the epoch the fingers ran in (right CRC, alive counter in sequence: a frame
 //! left in a queue, or a replay) is injected. The last round opens a new epoch, so the
 //! controller has retired that one: the finger does not move and the controller reports the
-//! ignored frame (FINGER_STATUS fault bit 6). The control: the same frame in the epoch the
-//! last round opened moves the finger, so the stale frame reached a controller that listened.
+//! ignored frame (FINGER_STATUS fault bit 6). The control: a SAFE_STOP that opens the epoch
+//! after the last round's, then the same ACTIVE frame in that epoch, moves the finger, so the
+//! stale frame reached a controller that listened. (The control used to be the ACTIVE frame
+//! in the last round's own epoch; it then had to arrive within the controller's 150 ms
+//! setpoint timeout of the last round, after which the controller retires that epoch too, and
+//! a guest stall between the test reading the last round and writing the control made it
+//! miss: "moved the finger only 0.000 rad". A new epoch's SAFE_STOP binds the controller
+//! whether or not it timed out in between.)
 
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -24,7 +30,7 @@ const FINGER: usize = 1;
 /// FINGER_STATUS fault bit 6: a setpoint ignored by the epoch rule.
 const FAULT_STALE_EPOCH: u8 = 1 << 6;
 /// From the stale frame to the control, µs: three statuses (20 ms apart) to see the finger
-/// still, and the control still well inside the 150 ms timeout of the last round.
+/// still.
 const CONTROL_AFTER_US: u64 = 60_000;
 /// How far the finger may drift while the stale frame is judged, rad (2 status LSB).
 const STILL_RAD: f64 = 0.002;
@@ -95,14 +101,17 @@ fn until_last_round(
 /// accepts it) and force of the velocity's sign (the controller moves only then). Returns
 /// the time just before it was written.
 fn inject(w: &CanSocket, epoch: u16, counter: u8, velocity: f64) -> u64 {
-    let sp = FingerSetpoint::new(
-        FINGER,
-        FingerMode::Active,
-        20.0_f64.copysign(velocity),
-        velocity,
-        epoch,
-    )
-    .expect("in range");
+    inject_mode(w, FingerMode::Active, epoch, counter, velocity)
+}
+
+/// A setpoint of `mode` (ACTIVE: force and velocity as [`inject`]; otherwise zero) of `epoch`.
+fn inject_mode(w: &CanSocket, mode: FingerMode, epoch: u16, counter: u8, velocity: f64) -> u64 {
+    let (force, velocity) = if mode == FingerMode::Active {
+        (20.0_f64.copysign(velocity), velocity)
+    } else {
+        (0.0, 0.0)
+    };
+    let sp = FingerSetpoint::new(FINGER, mode, force, velocity, epoch).expect("in range");
     let mut frame = sp.to_frame();
     seal(
         &mut frame,
@@ -140,6 +149,7 @@ fn stale_active_setpoint_before_the_next_epochs_safe_stop_after_sigterm_moves_no
         .expect("kill runs");
     assert!(term.success(), "kill -TERM handd failed");
     let (running, last) = until_last_round(&reader, before);
+    let last_at = now_us();
     let here = statuses(&rig.monitor.snapshot(), start, now_us())
         .last()
         .map(|s| s.1)
@@ -149,7 +159,24 @@ fn stale_active_setpoint_before_the_next_epochs_safe_stop_after_sigterm_moves_no
     while now_us() < stale_at + CONTROL_AFTER_US {
         std::thread::sleep(Duration::from_millis(1));
     }
-    let control_at = inject(&w, last.epoch(), last.counter() + 2, velocity);
+    // The control: the epoch after the last round's, opened by its SAFE_STOP, then ACTIVE.
+    let control_epoch = last.epoch().wrapping_add(1);
+    let opened_at = inject_mode(
+        &w,
+        FingerMode::SafeStop,
+        control_epoch,
+        last.counter() + 2,
+        0.0,
+    );
+    std::thread::sleep(Duration::from_millis(5));
+    let control_at = inject(&w, control_epoch, last.counter() + 3, velocity);
+    println!(
+        "stale: the last round read at 0 ms, the stale frame at {:.1} ms, the control's SAFE_STOP \
+         at {:.1} ms and its ACTIVE at {:.1} ms",
+        stale_at.saturating_sub(last_at) as f64 / 1000.0,
+        opened_at.saturating_sub(last_at) as f64 / 1000.0,
+        control_at.saturating_sub(last_at) as f64 / 1000.0
+    );
     std::thread::sleep(Duration::from_millis(250));
     rig.handd.wait_success(Duration::from_secs(10));
     sim.wait_success(Duration::from_secs(60));
@@ -160,7 +187,9 @@ fn stale_active_setpoint_before_the_next_epochs_safe_stop_after_sigterm_moves_no
         here,
         velocity,
         stale_at,
+        opened_at,
         control_at,
+        control_epoch,
     };
     check_stale_ignored(&seen, &w);
     check_control_moved(&seen, &w);
@@ -173,11 +202,13 @@ struct Window {
     here: f64,
     velocity: f64,
     stale_at: u64,
+    opened_at: u64,
     control_at: u64,
+    control_epoch: u16,
 }
 
 fn check_stale_ignored(seen: &[Seen], w: &Window) {
-    let during = statuses(seen, w.stale_at, w.control_at);
+    let during = statuses(seen, w.stale_at, w.opened_at);
     assert!(
         during.len() >= 2,
         "only {} statuses between the stale frame and the control",
@@ -220,7 +251,8 @@ fn check_stale_ignored(seen: &[Seen], w: &Window) {
     );
 }
 
-/// The control: the same frame in the epoch the last round opened moves the finger.
+/// The control: the same frame in the epoch after the last round's (opened by its SAFE_STOP)
+/// moves the finger.
 fn check_control_moved(seen: &[Seen], w: &Window) {
     let before = statuses(seen, w.stale_at, w.control_at)
         .last()
@@ -233,7 +265,7 @@ fn check_control_moved(seen: &[Seen], w: &Window) {
     println!(
         "stale: the control (same frame, epoch {:#06x}) moved the finger {moved:.3} rad ({} \
          statuses after it)",
-        w.last.epoch(),
+        w.control_epoch,
         after.len()
     );
     assert!(
