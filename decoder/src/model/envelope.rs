@@ -219,13 +219,15 @@ impl Envelope {
 
     /// The envelope with the calibration's channel patterns fitted from its windows: `rows`
     /// (raw feature vectors) with each window's per-finger targets (+ flexion, - extension,
-    /// 0 rest). With more movements than [`super::MAX_PATTERNS`] the test stays off.
+    /// 0 rest). With more movements than [`super::MAX_PATTERNS`], or a channel the
+    /// calibration never saw above 0 (no level to scale it by), the test stays off.
     pub fn with_patterns<'a>(
         self,
         windows: impl Iterator<Item = (&'a [f64], &'a [f64; 5])>,
     ) -> Result<Self, ModelError> {
         let channels = self.channels();
-        if channels > MAX_CHANNELS {
+        let dead = (0..channels).any(|c| self.max[c * FEATURES_PER_CHANNEL + self.rms] <= 0.0);
+        if channels > MAX_CHANNELS || dead {
             return Ok(self);
         }
         let mut rows: Vec<(Vec<f64>, [i8; 5], bool)> = Vec::new();
@@ -548,6 +550,21 @@ mod tests {
         let (text, flagged) = Envelope::describe(Some(&one));
         assert!(!flagged && text.contains("one channel"), "{text}");
         assert!(unit(2).with_cone(Some(cone(3, 0.0))).is_err());
+    }
+
+    #[test]
+    fn a_channel_the_calibration_never_saw_leaves_the_pattern_test_off() {
+        let mut max = vec![1.0; 2 * FEATURES_PER_CHANNEL];
+        let e = Envelope::try_new(max.clone()).expect("envelope");
+        max[FEATURES_PER_CHANNEL + e.rms] = 0.0;
+        let x = vec![0.5; 2 * FEATURES_PER_CHANNEL];
+        let rows = [(x.as_slice(), &[1.0, 0.0, 0.0, 0.0, 0.0])];
+        let live = e.with_patterns(rows.iter().copied()).expect("patterns");
+        assert!(live.cone().is_some());
+        let dead = Envelope::try_new(max)
+            .and_then(|e| e.with_patterns(rows.iter().copied()))
+            .expect("no error, the test off");
+        assert!(dead.cone().is_none());
     }
 
     #[test]
