@@ -26,7 +26,8 @@
 //! the model reads a movement into it (on the 3DC recordings, one channel at ten times its
 //! level points most movement windows the wrong way). So a window is **implausible** when one
 //! channel stands alone. The level of a channel is its RMS over the calibration's largest RMS
-//! of that channel, and two tests share one spread ([`PLAUSIBLE_SPREAD`]):
+//! of that channel, and two tests share one spread ([`PLAUSIBLE_SPREAD`]; the third, below,
+//! has its own margin):
 //! - *alone*: the top channel is above [`PLAUSIBLE_FLOOR`] and more than the next channel
 //!   times the larger of the spread and [`ALONE_MARGIN`] times the calibration's own largest
 //!   top-over-next ratio (recorded at training: [`Envelope::alone`]). A muscle is never under
@@ -299,8 +300,18 @@ impl Envelope {
                 true,
             );
         };
-        let (alone, alone_missing) = match e.alone {
-            _ if e.channels() < 2 => (
+        let (alone, alone_missing) = e.describe_alone();
+        let (patterns, patterns_missing) = e.describe_patterns();
+        (
+            format!("beyond the calibration: {alone}; {patterns}"),
+            alone_missing || patterns_missing,
+        )
+    }
+
+    /// The *alone* test, for [`Envelope::describe`]: its line, and whether it is missing.
+    fn describe_alone(&self) -> (String, bool) {
+        match self.alone {
+            _ if self.channels() < 2 => (
                 "bounded by its envelope (one channel: no alone test)".to_string(),
                 false,
             ),
@@ -318,8 +329,13 @@ impl Envelope {
                     .to_string(),
                 true,
             ),
-        };
-        let (patterns, patterns_missing) = match &e.cone {
+        }
+    }
+
+    /// The *off the patterns* test, for [`Envelope::describe`]: its line, and whether it is
+    /// missing.
+    fn describe_patterns(&self) -> (String, bool) {
+        match &self.cone {
             None => (
                 "the pattern test is OFF (the file records no channel patterns: an older \
                  model, so a band turned on the forearm is not caught; retrain it to get the \
@@ -345,11 +361,7 @@ impl Envelope {
                 ),
                 false,
             ),
-        };
-        (
-            format!("beyond the calibration: {alone}; {patterns}"),
-            alone_missing || patterns_missing,
-        )
+        }
     }
 
     /// Channels the envelope covers.

@@ -254,42 +254,44 @@ fn read_meta(version: u32, body: &[u8]) -> Result<(Meta, &[u8]), FileError> {
     if !unknown.is_empty() {
         return Err(FileError::UnknownRequired { sections: unknown });
     }
-    if meta.taught.is_some() && !meta.required.iter().any(|r| r == "taught") {
-        return Err(malformed(
-            "taught present but not listed in required".into(),
-        ));
-    }
-    if version >= 2
-        && meta.envelope_alone.is_some()
-        && !meta.required.iter().any(|r| r == "envelope_alone")
-    {
-        return Err(malformed(
-            "envelope_alone present but not listed in required".into(),
-        ));
-    }
-    if version >= 2
-        && meta.envelope_patterns.is_some()
-        && !meta.required.iter().any(|r| r == "envelope_patterns")
-    {
-        return Err(malformed(
-            "envelope_patterns present but not listed in required".into(),
-        ));
-    }
-    if meta.envelope_patterns.is_some() && meta.envelope.is_none() {
-        return Err(malformed("envelope_patterns without an envelope".into()));
-    }
-    if meta.envelope_alone.is_some() && meta.envelope.is_none() {
-        return Err(malformed("envelope_alone without an envelope".into()));
-    }
-    if meta.rest_stage.is_some() && !meta.required.iter().any(|r| r == "rest_stage") {
-        // Only a version 1 file may carry a rest stage without saying it is required.
-        if version >= 2 {
-            return Err(malformed(
-                "rest_stage present but not listed in required".into(),
-            ));
+    check_listed(&meta, version)?;
+    Ok((meta, data))
+}
+
+/// Every section present that changes the outputs is listed in `required` (version 2 on; a
+/// `taught` section in any version: it came after `required`), and an envelope's parts have
+/// their envelope.
+fn check_listed(meta: &Meta, version: u32) -> Result<(), FileError> {
+    let sections = [
+        ("taught", meta.taught.is_some(), true),
+        ("rest_stage", meta.rest_stage.is_some(), version >= 2),
+        (
+            "envelope_alone",
+            meta.envelope_alone.is_some(),
+            version >= 2,
+        ),
+        (
+            "envelope_patterns",
+            meta.envelope_patterns.is_some(),
+            version >= 2,
+        ),
+    ];
+    for (name, present, must_list) in sections {
+        if present && must_list && !meta.required.iter().any(|r| r == name) {
+            return Err(FileError::Malformed(format!(
+                "{name} present but not listed in required"
+            )));
         }
     }
-    Ok((meta, data))
+    for (name, present) in [
+        ("envelope_alone", meta.envelope_alone.is_some()),
+        ("envelope_patterns", meta.envelope_patterns.is_some()),
+    ] {
+        if present && meta.envelope.is_none() {
+            return Err(FileError::Malformed(format!("{name} without an envelope")));
+        }
+    }
+    Ok(())
 }
 
 /// The metadata's signal chain configuration: valid, and agreeing with the header fields.
