@@ -86,11 +86,13 @@ fn check_participant(participant: u32) {
     );
     assert!(report.rays() > 3000, "{} rays", report.rays());
     assert_eq!(report.reversing(), 0, "{:?}", report.worst());
-    // Issue 25 item 3: the same rays out to effort 10, through the envelope's clipping. The
-    // defaults DO reverse between effort 1 and the envelope's edge (P4 890 of 3375 rays, worst
-    // 0.756; P6 134, 0.208; P7 229, 0.149): printed, not hidden; the bars are that the proof
-    // describes the predictor (the hold beyond the edge confirmed on every ray) and that no
-    // ray reverses on [0, 1].
+    // Issue 25 item 3: the same rays out to effort 10, through the envelope's clipping, judged
+    // on the label the hand gets (clamped to full scale). Trained with the penalty past full
+    // effort (the default since session 32), P6 and P7 pass and P4 does not: 12 of 3375 rays
+    // reverse between effort 1.7 and 4 by up to 0.031 (without the penalty past full effort:
+    // P4 563 rays, worst 0.756; P6 54, 0.208; P7 1, 0.043). Printed, not hidden; the bars: the
+    // proof describes the predictor (the hold beyond the edge confirmed on every ray), no ray
+    // reverses on [0, 1], and the reversals beyond stay at the level reached.
     let beyond = verify_beyond(
         &mut v,
         &train_w,
@@ -106,6 +108,12 @@ fn check_participant(participant: u32) {
         beyond.reversing(),
         beyond.reversing_beyond_only(),
         "{beyond}"
+    );
+    let worst = beyond.worst().map_or(0.0, |w| w.worst.amount);
+    assert!(
+        beyond.reversing() <= 20 && worst <= 0.05,
+        "{} rays reverse beyond full effort, worst {worst:.3}",
+        beyond.reversing()
     );
 }
 
@@ -187,10 +195,11 @@ fn beyond_the_calibration(
     }
     // Not the issue's target (no finger the wrong way): one channel that the gesture itself
     // drives, at x10, is not always told from a stronger contraction by the plausibility
-    // check (P7 channel 4: 26.8%, P6 channel 2: 5.9%; without the check 47-90%). The bar is
-    // the level reached, so that it cannot get worse unseen.
+    // check (P7 channel 4: 31.7% with the penalty past full effort, 26.7% without it; P6
+    // channel 2: 1.8%; without the check 47-90%). The bar is the level reached, so that it
+    // cannot get worse unseen.
     assert!(
-        worst.0 <= 30.0,
+        worst.0 <= 35.0,
         "channel {} at x10: {:.2}% of the movement finger-windows point the wrong way",
         worst.1,
         worst.0

@@ -33,6 +33,7 @@
 //! Settings are validated once by the config layer; this code cannot fail and does not allocate.
 
 use crate::units::{Newton, RadPerSec, RadPerSec2};
+use decoder::model::hand_label;
 
 /// Largest kF, N per label unit: the gains' ramp rate is this range per `ramp_s`.
 pub const KF_MAX: f64 = 40.0;
@@ -150,12 +151,7 @@ impl FingerConditioner {
         dt_s: f64,
         feedback: Feedback,
     ) -> Setpoint {
-        let x = if raw.is_finite() {
-            raw.clamp(-1.0, 1.0)
-        } else {
-            0.0
-        };
-        let x = deadband(x, gains.deadband);
+        let x = deadband(hand_label(raw), gains.deadband);
         let max_step = gains.slew_per_s * dt_s;
         self.label += (x - self.label).clamp(-max_step, max_step);
 

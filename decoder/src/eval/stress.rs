@@ -24,7 +24,7 @@
 
 use super::interpolation::scale_features;
 use crate::dsp::FEATURES_PER_CHANNEL;
-use crate::model::{TrainedModel, N_FINGERS};
+use crate::model::{hand_label, TrainedModel, N_FINGERS};
 use crate::session::{LabelledWindows, Session, SessionError, TrialKind, WindowOptions};
 
 /// The gains replayed: x1 (the recording as it is) to x5.
@@ -103,7 +103,7 @@ fn replay(
         for f in (0..N_FINGERS).filter(|&f| l.mask[f] && l.targets[f] != 0.0) {
             r.movement += 1;
             let s = l.targets[f].signum();
-            r.wrong += usize::from(s * y[f].clamp(-1.0, 1.0) < -WRONG_WAY);
+            r.wrong += usize::from(s * hand_label(y[f]) < -WRONG_WAY);
         }
     }
     r
@@ -322,7 +322,7 @@ mod tests {
         for (y, l) in direct.iter().zip(&w.labels) {
             for (v, t) in y.iter().zip(&l.targets) {
                 max = max.max(v.abs());
-                wrong += usize::from(t * v.clamp(-1.0, 1.0) < -WRONG_WAY);
+                wrong += usize::from(t * hand_label(*v) < -WRONG_WAY);
             }
         }
         let x1 = &r.gains[0];

@@ -70,7 +70,7 @@ pub use error::{FileError, ModelError, TrainError};
 pub use file::{FORMAT_VERSION, HEADER_LEN, MAGIC, NORMALIZER_TENSOR};
 pub use kind::ModelKind;
 pub use normalizer::Normalizer;
-pub use output::OutputStage;
+pub use output::{hand_label, OutputStage};
 pub use provenance::Provenance;
 pub use resdd::{ResDd, ResDdActivations, RESDD_INPUT_GAIN};
 pub use rest::{RestFit, RestStage, MAX_REST_WIDTH, REST_SHARPNESS};

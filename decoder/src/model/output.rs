@@ -11,6 +11,20 @@ use super::dataset::N_FINGERS;
 use super::rest::RestStage;
 use super::taught::Taught;
 
+/// The label a finger gets from a model's output: clamped to full scale, `[-1, 1]` (the
+/// labels' range: `F = kF·label`, `α = kα·label`), a non-finite output to 0 (rest: the caller
+/// reports it as a fault). Non-decreasing with slope at most 1 on finite outputs. The daemon's
+/// conditioner and the check beyond full effort ([`super::verify::verify_beyond`]) both call
+/// it: the verifier judges the label the hand gets.
+#[inline]
+pub fn hand_label(y: f64) -> f64 {
+    if y.is_finite() {
+        y.clamp(-1.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
 /// The rest stage then the taught-direction hold.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct OutputStage {

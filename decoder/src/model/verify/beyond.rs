@@ -31,6 +31,13 @@
 //! far `dir·y` rises above the trial's full-effort value for that finger: the larger of full
 //! scale (1) and the largest `dir·y(1)` of the trial's windows (what the calibration's own
 //! strongest window gave), both against the tolerance.
+//!
+//! Both judge the label the hand gets: the output stage, then [`hand_label`] (clamped to full
+//! scale, as the daemon's conditioner clamps it; the same function). An output that rises above
+//! full scale and comes back to it is no reversal the hand can show, and the label never rises
+//! above full scale: the overshoot count guards that the clamp is on the path (a path without
+//! it would show the raw outputs' overshoot, up to 1.2 on the 3DC participants). On `[0, 1]`
+//! ([`super::verify_windows`]) the raw output stays the judge: the training's own property.
 
 use std::fmt;
 
@@ -40,7 +47,7 @@ use super::ray::RayVerifier;
 use super::reversal::{exact_reversal_through, largest_drop, Method, Reversal};
 use super::roots::roots_in_unit;
 use crate::eval::scale_features;
-use crate::model::{OutputStage, N_FINGERS};
+use crate::model::{hand_label, OutputStage, N_FINGERS};
 use crate::session::{LabelledWindows, Trial, FINGER_NAMES};
 
 /// The largest effort checked: ten times the calibration window's.
@@ -307,7 +314,7 @@ fn ray_outcome(
                     v
                 })
                 .collect();
-            let g = |y: f64| stage.map(f, y);
+            let g = |y: f64| hand_label(stage.map(f, y));
             let mut r = exact_reversal_through(&q, dir, &g, stage.max_slope(f));
             r.from_k *= end;
             r.to_k *= end;
@@ -332,11 +339,11 @@ fn ray_outcome(
             let points: Vec<(f64, f64)> = (0..n)
                 .map(|i| {
                     let k = end * i as f64 / (n - 1) as f64;
-                    (k, v.output_at(row, k)[f])
+                    (k, hand_label(v.output_at(row, k)[f]))
                 })
                 .collect();
             let unit: Vec<(f64, f64)> = points.iter().copied().filter(|p| p.0 <= 1.0).collect();
-            let full = dir * v.output_at(row, end.min(1.0))[f];
+            let full = dir * hand_label(v.output_at(row, end.min(1.0))[f]);
             let peak = points
                 .iter()
                 .map(|p| dir * p.1)
