@@ -381,6 +381,14 @@ proptest! {
     }
 }
 
+/// A one-channel window at half its level: RMS-like features halved, VAR (index 2) quartered.
+fn at_half(full: &[f64]) -> Vec<f64> {
+    full.iter()
+        .enumerate()
+        .map(|(j, v)| v * if j == 2 { 0.25 } else { 0.5 })
+        .collect()
+}
+
 /// Issue 25 item 3: beyond full effort. A dipping ResDD (dip on `(0.502, 0.718)` of its full
 /// window, from 0.826 down to 0.806: below full scale, where the hand sees it) with its window
 /// at half its level (RMS 0.5, VAR 0.25) puts the dip at efforts 1.004 to 1.436: [0, 1] passes,
@@ -394,11 +402,7 @@ fn beyond_full_effort_the_dip_is_found_unless_the_envelope_holds_the_ray_before_
     use decoder::model::{hand_label, Envelope};
     let r: f64 = 0.108;
     let (model, full) = dipping_resdd_at(0.015 / r.powi(3), 0.61, r);
-    let half: Vec<f64> = full
-        .iter()
-        .enumerate()
-        .map(|(j, v)| v * if j == 2 { 0.25 } else { 0.5 })
-        .collect();
+    let half = at_half(&full);
     let (windows, trials) = one_window(half.clone());
     let tol = DEFAULT_TOLERANCE;
     let check = |m: &TrainedModel| {
@@ -460,11 +464,7 @@ fn beyond_full_effort_the_dip_is_found_unless_the_envelope_holds_the_ray_before_
     // The first dipping model: the same dip at efforts 1.03-1.07, but at outputs near 700,
     // clamped to full scale for the hand: no reversal beyond full effort.
     let (above, full) = dipping_resdd();
-    let half: Vec<f64> = full
-        .iter()
-        .enumerate()
-        .map(|(j, v)| v * if j == 2 { 0.25 } else { 0.5 })
-        .collect();
+    let half = at_half(&full);
     let (windows, trials) = one_window(half.clone());
     let mut v = RayVerifier::exact(&above).unwrap();
     assert!(v.output_at(&half, 1.05)[0] > 100.0);
