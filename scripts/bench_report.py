@@ -155,7 +155,7 @@ def tick_section(rows):
     for key, what in (("us_front", "front end: E2E check, decode, reassembly, rails, uV (~163 frames)"),
                       ("us_filters", "filters (DC, band-pass, notch), 12 x 50 samples, into the window"),
                       ("us_features", "features: 96 over the 200-sample window"),
-                      ("us_model", "model: normalize + ResDD H=96 L=2"),
+                      ("us_model", "model: normalize, envelope and plausibility tests, ResDD H=96 L=2, output stage"),
                       ("us_rest", "the rest: dispatch, faults, conditioning, encode (mean minus the above)")):
         lines.append(f"| {what} | {t[key]:.2f} | {100 * t[key] / mean:.0f} % |")
     if t["us_rest"] < 0:

@@ -26,9 +26,7 @@ use std::time::Duration;
 
 use cpu_time::ThreadTime;
 use decoder::dsp::{Chain, ChainConfig, ChainSettings};
-use decoder::model::{
-    AnyModel, ModelKind, ModelSpec, Normalizer, Predictor, Trainable, TrainedModel, TrainingSummary,
-};
+use decoder::model::{AnyModel, ModelKind, ModelSpec, Predictor, Trainable, TrainedModel};
 use driver::engine::{Engine, EngineSettings};
 use hand_dbc::emg_front::{EmgFront, EmgFrontConfig, EmgFrontSettings};
 use hand_dbc::CanFrame;
@@ -49,20 +47,41 @@ fn model(chain: &ChainConfig) -> AnyModel {
     AnyModel::random(ModelKind::ResDd, &spec, 8 * chain.channels, 5, 1).expect("model")
 }
 
-/// How many f64 weights the model holds.
+/// How many f64 weights the model holds (the default spec, as the trained model's).
 fn n_weights(chain: &ChainConfig) -> usize {
     model(chain).params().len()
 }
 
+/// The model handd would run: the demo's simulated calibration (seed 1), trained with the
+/// defaults, so the tick pays for everything a calibrated model does (the envelope's
+/// projection, the plausibility tests with the calibration's channel patterns, the rest
+/// stage). Trained once per run, on the same chain as the traffic.
 fn predictor(chain: &ChainConfig) -> Predictor {
-    let n_in = 8 * chain.channels;
-    let spec = ModelSpec::default();
-    let model = model(chain);
-    let summary = TrainingSummary::untrained(ModelKind::ResDd);
-    let norm = Normalizer::from_scales(vec![100.0; n_in]).expect("scales");
-    TrainedModel::new(model, spec, norm, chain.clone(), summary)
-        .expect("model")
-        .predictor()
+    use driver::demo::{record_calibration, train_on_session, DemoOptions};
+    use std::sync::OnceLock;
+    static MODEL: OnceLock<TrainedModel> = OnceLock::new();
+    let m = MODEL.get_or_init(|| {
+        let dir = std::env::temp_dir().join(format!("tick-tail-cal-{}", std::process::id()));
+        let opts = DemoOptions {
+            work_dir: dir.clone(),
+            ..DemoOptions::default()
+        };
+        record_calibration(&dir, opts.seed).expect("simulated calibration");
+        let session = decoder::session::Session::open(&dir).expect("session");
+        let m = train_on_session(&session, &opts, &mut |_| {}).expect("training");
+        std::fs::remove_dir_all(&dir).expect("clean up");
+        let e = m.envelope().expect("a trained model has an envelope");
+        eprintln!(
+            "model: the demo's calibration (seed {}), trained: envelope, alone test {}, {} channel \
+             patterns",
+            opts.seed,
+            if e.alone().is_some() { "on" } else { "off" },
+            e.cone().map_or(0, |c| c.patterns().count())
+        );
+        m
+    });
+    assert_eq!(m.chain(), chain, "the model's chain is the traffic's");
+    m.predictor()
 }
 
 fn engine(chain: &ChainConfig, settings: EngineSettings) -> Engine {
@@ -565,7 +584,10 @@ fn main() {
         ("front end: E2E, decode, reassembly, rails, uV", s.front),
         ("filters (DC, band-pass, notch) + window", s.filters),
         ("features (96, whole window)", s.features),
-        ("model (normalize + ResDD H=96 L=2)", s.model),
+        (
+            "model (normalize, envelope and plausibility, ResDD H=96 L=2, output stage)",
+            s.model,
+        ),
         ("the rest: dispatch, faults, conditioning, encode", rest),
     ] {
         println!("| {what} | {us:.2} | {:.0} % |", 100.0 * us / mean);

@@ -69,12 +69,43 @@ impl RestFit {
     }
 }
 
-/// The fitted stage: per finger the dead zone's width above and below zero.
+/// The fitted stage: per finger the dead zone's width above and below zero. Written and read
+/// as its three settings; what is read is not validated here: the model file's reader checks
+/// it with [`RestStage::try_new`] and names the section in its error.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(from = "StageSettings", into = "StageSettings")]
 pub struct RestStage {
     up: [f64; N_FINGERS],
     down: [f64; N_FINGERS],
     sharpness: f64,
+    /// `h(1; d)` per finger above and below zero, `g`'s normalisation: computed once here, not
+    /// twice per output in the tick (the same value, so the same bits).
+    knee_up: [f64; N_FINGERS],
+    knee_down: [f64; N_FINGERS],
+}
+
+/// What the model file records of a [`RestStage`].
+#[derive(Serialize, Deserialize)]
+struct StageSettings {
+    up: [f64; N_FINGERS],
+    down: [f64; N_FINGERS],
+    sharpness: f64,
+}
+
+impl From<StageSettings> for RestStage {
+    fn from(s: StageSettings) -> Self {
+        RestStage::unchecked(s.up, s.down, s.sharpness)
+    }
+}
+
+impl From<RestStage> for StageSettings {
+    fn from(s: RestStage) -> Self {
+        StageSettings {
+            up: s.up,
+            down: s.down,
+            sharpness: s.sharpness,
+        }
+    }
 }
 
 /// `h(u; d)` for `u >= 0` (see the module docs).
@@ -121,11 +152,17 @@ impl RestStage {
                 )));
             }
         }
-        Ok(RestStage {
+        Ok(Self::unchecked(up, down, sharpness))
+    }
+
+    fn unchecked(up: [f64; N_FINGERS], down: [f64; N_FINGERS], sharpness: f64) -> Self {
+        RestStage {
             up,
             down,
             sharpness,
-        })
+            knee_up: up.map(|d| knee(1.0, d, sharpness)),
+            knee_down: down.map(|d| knee(1.0, d, sharpness)),
+        }
     }
 
     /// Fits the widths from the model's outputs on rest windows (see the module docs). Errors
@@ -175,11 +212,9 @@ impl RestStage {
     pub fn map(&self, finger: usize, y: f64) -> f64 {
         let n = self.sharpness;
         if y >= 0.0 {
-            let d = self.up[finger];
-            knee(y, d, n) / knee(1.0, d, n)
+            knee(y, self.up[finger], n) / self.knee_up[finger]
         } else {
-            let d = self.down[finger];
-            -knee(-y, d, n) / knee(1.0, d, n)
+            -knee(-y, self.down[finger], n) / self.knee_down[finger]
         }
     }
 
@@ -225,6 +260,31 @@ pub(crate) fn with_fitted_rest(
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    #[test]
+    fn the_cached_normalisation_gives_the_formula_bit_for_bit_and_survives_the_file() {
+        let up = [0.0, 0.1, 0.22, 0.5, 0.9];
+        let down = [0.9, 0.0, 0.1, 0.03, 0.25];
+        let st = RestStage::try_new(up, down, REST_SHARPNESS).unwrap();
+        for f in 0..N_FINGERS {
+            for i in -300..=300 {
+                let y = f64::from(i) / 100.0;
+                let want = if y >= 0.0 {
+                    knee(y, up[f], REST_SHARPNESS) / knee(1.0, up[f], REST_SHARPNESS)
+                } else {
+                    -knee(-y, down[f], REST_SHARPNESS) / knee(1.0, down[f], REST_SHARPNESS)
+                };
+                assert_eq!(st.map(f, y).to_bits(), want.to_bits(), "finger {f}, y {y}");
+            }
+        }
+        let text = serde_json::to_string(&st).unwrap();
+        assert!(
+            !text.contains("knee"),
+            "the file records the settings only: {text}"
+        );
+        let back: RestStage = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, st);
+    }
 
     fn width() -> impl Strategy<Value = f64> {
         prop_oneof![Just(0.0), 0.0..=MAX_REST_WIDTH]
