@@ -140,7 +140,11 @@ def tick_section(rows):
     lines = [
         f"Whole daemon tick over {int(t['ticks']):,} ticks of recorded traffic (20 s of simulated bus "
         f"traffic replayed lap after lap), CPU time per tick from a 10 ns histogram "
-        f"(`driver/examples/tick_tail.rs`), the middle of {n} round{'s' if n > 1 else ''} by median: "
+        f"(`driver/examples/tick_tail.rs`; the model is the demo's simulated calibration trained with "
+        f"the defaults, so every tick pays for what a calibrated model does in handd: the envelope's "
+        f"projection, the plausibility tests with the calibration's channel patterns, the rest "
+        f"stage; before session 32 it was a random model with none of them, median 11.3 us), "
+        f"the middle of {n} round{'s' if n > 1 else ''} by median: "
         f"median "
         f"**{med:.1f} us**{spread('us_cpu_median')} (goal <= 10 us: "
         f"{'hit' if med <= 10 else '**missed**'}), p99 **{p99:.1f} us**{spread('us_cpu_p99')} "
