@@ -57,24 +57,16 @@ fn n_weights(chain: &ChainConfig) -> usize {
 /// projection, the plausibility tests with the calibration's channel patterns, the rest
 /// stage). Trained once per run, on the same chain as the traffic.
 fn predictor(chain: &ChainConfig) -> Predictor {
-    use driver::demo::{record_calibration, train_on_session, DemoOptions};
+    use driver::demo::{calibrated_model, DemoOptions};
     use std::sync::OnceLock;
     static MODEL: OnceLock<TrainedModel> = OnceLock::new();
     let m = MODEL.get_or_init(|| {
-        let dir = std::env::temp_dir().join(format!("tick-tail-cal-{}", std::process::id()));
-        let opts = DemoOptions {
-            work_dir: dir.clone(),
-            ..DemoOptions::default()
-        };
-        record_calibration(&dir, opts.seed).expect("simulated calibration");
-        let session = decoder::session::Session::open(&dir).expect("session");
-        let m = train_on_session(&session, &opts, &mut |_| {}).expect("training");
-        std::fs::remove_dir_all(&dir).expect("clean up");
+        let seed = DemoOptions::default().seed;
+        let m = calibrated_model(seed).expect("the demo's calibration, trained");
         let e = m.envelope().expect("a trained model has an envelope");
         eprintln!(
-            "model: the demo's calibration (seed {}), trained: envelope, alone test {}, {} channel \
-             patterns",
-            opts.seed,
+            "model: the demo's calibration (seed {seed}), trained: envelope, alone test {}, {} \
+             channel patterns",
             if e.alone().is_some() { "on" } else { "off" },
             e.cone().map_or(0, |c| c.patterns().count())
         );

@@ -302,6 +302,23 @@ pub fn record_scenario(dir: &Path, seed: u64, scenario: Scenario) -> Result<usiz
     Ok(run.trials.len())
 }
 
+/// The demo's calibration for `seed` recorded into a scratch directory under the system's
+/// temporary directory (named after the process), trained with the demo's options
+/// ([`train_on_session`]), the directory removed: the model a calibrated handd runs in the
+/// simulated world, for tests and the tick benchmark.
+pub fn calibrated_model(seed: u64) -> Result<TrainedModel, DemoError> {
+    let dir = std::env::temp_dir().join(format!("handstack-cal-{}-{seed}", std::process::id()));
+    let opts = DemoOptions {
+        work_dir: dir.clone(),
+        seed,
+        ..DemoOptions::default()
+    };
+    record_calibration(&dir, seed)?;
+    let model = train_on_session(&Session::open(&dir)?, &opts, &mut |_| {});
+    std::fs::remove_dir_all(&dir).map_err(io(&dir))?;
+    model
+}
+
 /// ResDD trained on `session`'s calibration with the demo's label and training options, then
 /// verified as `handctl train` verifies it ([`certify`]); the long-run script trains the same way.
 pub fn train_on_session(

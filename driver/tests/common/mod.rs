@@ -46,17 +46,10 @@ pub fn calibrated_predictor() -> Predictor {
     static MODEL: OnceLock<Predictor> = OnceLock::new();
     MODEL
         .get_or_init(|| {
-            use driver::demo::{record_calibration, train_on_session, DemoOptions};
-            let dir = std::env::temp_dir().join(format!("handstack-cal-{}", std::process::id()));
-            let opts = DemoOptions {
-                work_dir: dir.clone(),
-                ..DemoOptions::default()
-            };
-            record_calibration(&dir, opts.seed).expect("simulated calibration");
-            let session = decoder::session::Session::open(&dir).expect("session");
-            let m = train_on_session(&session, &opts, &mut |_| {}).expect("training");
-            std::fs::remove_dir_all(&dir).expect("clean up");
-            m.predictor()
+            let seed = driver::demo::DemoOptions::default().seed;
+            driver::demo::calibrated_model(seed)
+                .expect("the demo's calibration, trained")
+                .predictor()
         })
         .clone()
 }
