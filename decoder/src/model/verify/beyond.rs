@@ -202,29 +202,9 @@ pub fn verify_beyond(
             let dir = label.targets[f].signum();
             let o = ray_outcome(verifier, row, &polys, f, dir, end);
             let held_ok = held.iter().all(|(y, want)| close(y[f], want[f]));
-            let at = match entries
-                .iter()
-                .position(|e| e.trial == name && e.finger == f)
-            {
-                Some(at) => at,
-                None => {
-                    entries.push(BeyondEntry::new(name.clone(), f, verifier.method()));
-                    entries.len() - 1
-                }
-            };
-            let e = &mut entries[at];
-            e.rays += 1;
-            let rev = o.reversal.amount > tolerance;
-            e.reversing += usize::from(rev);
-            e.reversing_beyond_only += usize::from(rev && o.reversal_unit <= tolerance);
-            if o.reversal.amount > e.worst.amount || e.rays == 1 {
-                e.worst = o.reversal;
-            }
-            e.full_effort = e.full_effort.max(o.full);
+            let at = entry_at(&mut entries, &name, f, verifier.method());
+            entries[at].count(&o, tolerance, rest_from.is_some(), held_ok, edge);
             peaks.push((at, o.peak));
-            e.resting += usize::from(rest_from.is_some());
-            e.not_held += usize::from(!held_ok);
-            e.lowest_edge = e.lowest_edge.min(edge);
         }
     }
     for (at, peak) in peaks {
@@ -240,6 +220,20 @@ pub fn verify_beyond(
         has_envelope: verifier.envelope().is_some(),
         entries,
     })
+}
+
+/// The index of the entry of `trial` and `finger` in `entries`, added when missing.
+fn entry_at(entries: &mut Vec<BeyondEntry>, trial: &str, finger: usize, method: Method) -> usize {
+    match entries
+        .iter()
+        .position(|e| e.trial == trial && e.finger == finger)
+    {
+        Some(at) => at,
+        None => {
+            entries.push(BeyondEntry::new(trial.to_string(), finger, method));
+            entries.len() - 1
+        }
+    }
 }
 
 /// Two outputs of the same computation, up to rounding of the projection.
@@ -302,63 +296,88 @@ fn ray_outcome(
     end: f64,
 ) -> RayOutcome {
     match polys {
-        Some((p, stage)) => {
-            let p = &p[f];
-            // q(t) = p(end·t), t in [0, 1].
-            let mut s = 1.0;
-            let q: Vec<f64> = p
-                .iter()
-                .map(|c| {
-                    let v = c * s;
-                    s *= end;
-                    v
-                })
-                .collect();
-            let g = |y: f64| hand_label(stage.map(f, y));
-            let mut r = exact_reversal_through(&q, dir, &g, stage.max_slope(f));
-            r.from_k *= end;
-            r.to_k *= end;
-            let unit = exact_reversal_through(p, dir, &g, stage.max_slope(f)).amount;
-            let roots = roots_in_unit(&derivative(&q));
-            let peak = roots
-                .points
-                .iter()
-                .chain(&[0.0, 1.0])
-                .map(|&t| dir * g(eval(&q, t)))
-                .fold(f64::NEG_INFINITY, f64::max);
-            let full = dir * g(eval(p, end.min(1.0)));
-            RayOutcome {
-                reversal: r,
-                reversal_unit: unit,
-                peak,
-                full,
-            }
-        }
-        None => {
-            let n = super::SAMPLED_POINTS;
-            let points: Vec<(f64, f64)> = (0..n)
-                .map(|i| {
-                    let k = end * i as f64 / (n - 1) as f64;
-                    (k, hand_label(v.output_at(row, k)[f]))
-                })
-                .collect();
-            let unit: Vec<(f64, f64)> = points.iter().copied().filter(|p| p.0 <= 1.0).collect();
-            let full = dir * hand_label(v.output_at(row, end.min(1.0))[f]);
-            let peak = points
-                .iter()
-                .map(|p| dir * p.1)
-                .fold(f64::NEG_INFINITY, f64::max);
-            RayOutcome {
-                reversal: largest_drop(&points, dir, Method::Sampled(n)),
-                reversal_unit: largest_drop(&unit, dir, Method::Sampled(n)).amount,
-                peak,
-                full,
-            }
-        }
+        Some((p, stage)) => exact_outcome(&p[f], stage, f, dir, end),
+        None => sampled_outcome(v, row, f, dir, end),
+    }
+}
+
+/// [`ray_outcome`] on the ray's polynomial `p`, through the output stage and the hand's clamp.
+fn exact_outcome(p: &[f64], stage: &OutputStage, f: usize, dir: f64, end: f64) -> RayOutcome {
+    // q(t) = p(end·t), t in [0, 1].
+    let mut s = 1.0;
+    let q: Vec<f64> = p
+        .iter()
+        .map(|c| {
+            let v = c * s;
+            s *= end;
+            v
+        })
+        .collect();
+    let g = |y: f64| hand_label(stage.map(f, y));
+    let mut r = exact_reversal_through(&q, dir, &g, stage.max_slope(f));
+    r.from_k *= end;
+    r.to_k *= end;
+    let unit = exact_reversal_through(p, dir, &g, stage.max_slope(f)).amount;
+    let roots = roots_in_unit(&derivative(&q));
+    let peak = roots
+        .points
+        .iter()
+        .chain(&[0.0, 1.0])
+        .map(|&t| dir * g(eval(&q, t)))
+        .fold(f64::NEG_INFINITY, f64::max);
+    RayOutcome {
+        reversal: r,
+        reversal_unit: unit,
+        peak,
+        full: dir * g(eval(p, end.min(1.0))),
+    }
+}
+
+/// [`ray_outcome`] sampled on the predictor at [`super::SAMPLED_POINTS`] efforts.
+fn sampled_outcome(
+    v: &mut RayVerifier<'_>,
+    row: &[f64],
+    f: usize,
+    dir: f64,
+    end: f64,
+) -> RayOutcome {
+    let n = super::SAMPLED_POINTS;
+    let points: Vec<(f64, f64)> = (0..n)
+        .map(|i| {
+            let k = end * i as f64 / (n - 1) as f64;
+            (k, hand_label(v.output_at(row, k)[f]))
+        })
+        .collect();
+    let unit: Vec<(f64, f64)> = points.iter().copied().filter(|p| p.0 <= 1.0).collect();
+    let peak = points
+        .iter()
+        .map(|p| dir * p.1)
+        .fold(f64::NEG_INFINITY, f64::max);
+    RayOutcome {
+        reversal: largest_drop(&points, dir, Method::Sampled(n)),
+        reversal_unit: largest_drop(&unit, dir, Method::Sampled(n)).amount,
+        peak,
+        full: dir * hand_label(v.output_at(row, end.min(1.0))[f]),
     }
 }
 
 impl BeyondEntry {
+    /// Counts one ray's outcome (its overshoot is counted once every ray's full effort is
+    /// known).
+    fn count(&mut self, o: &RayOutcome, tolerance: f64, resting: bool, held: bool, edge: f64) {
+        self.rays += 1;
+        let rev = o.reversal.amount > tolerance;
+        self.reversing += usize::from(rev);
+        self.reversing_beyond_only += usize::from(rev && o.reversal_unit <= tolerance);
+        if o.reversal.amount > self.worst.amount || self.rays == 1 {
+            self.worst = o.reversal;
+        }
+        self.full_effort = self.full_effort.max(o.full);
+        self.resting += usize::from(resting);
+        self.not_held += usize::from(!held);
+        self.lowest_edge = self.lowest_edge.min(edge);
+    }
+
     fn new(trial: String, finger: usize, method: Method) -> Self {
         BeyondEntry {
             trial,
